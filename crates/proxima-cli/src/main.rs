@@ -1,0 +1,4 @@
+fn main() {
+    eprintln!("proxima: no command yet");
+    std::process::exit(2);
+}

@@ -1,0 +1,385 @@
+//! Index-based storage shared by every structure: a generational [`Arena`] for the
+//! user's objects (stable [`Handle`]s, O(1) insert/remove/lookup) and a plain
+//! [`Pool`] with a free list for tree nodes. Both are flat `Vec`s, as in Box2D's
+//! `b2DynamicTree`; this is the seed's "equal-size block allocator".
+
+use crate::{Error, Result};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// A reference to an object stored in an index.
+///
+/// Handles are generational: after `remove` (or `clear`) the same slot may be reused,
+/// but the old handle then fails with [`Error::StaleHandle`] instead of naming a
+/// different object. Each arena also carries a tag drawn when it is created or
+/// cleared, so a handle from another index is rejected too (up to 2^32 arenas).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Handle {
+    tag: u32,
+    index: u32,
+    generation: u32,
+}
+
+impl Handle {
+    /// The slot number: dense, small, stable while the object lives. Useful as an
+    /// index into side tables.
+    pub fn index(self) -> u32 {
+        self.index
+    }
+    /// The slot's generation when this handle was issued.
+    pub fn generation(self) -> u32 {
+        self.generation
+    }
+}
+
+static NEXT_TAG: AtomicU32 = AtomicU32::new(1);
+
+fn fresh_tag() -> u32 {
+    NEXT_TAG.fetch_add(1, Ordering::Relaxed)
+}
+
+const NONE: u32 = u32::MAX;
+
+#[derive(Clone, Debug)]
+enum Entry<V> {
+    Occupied(V),
+    Vacant { next_free: u32 },
+}
+
+#[derive(Clone, Debug)]
+struct Slot<V> {
+    generation: u32,
+    entry: Entry<V>,
+}
+
+/// Generational slot arena: values addressed by [`Handle`], with a free list.
+/// `insert`, `remove`, `get` are O(1).
+#[derive(Clone, Debug)]
+pub struct Arena<V> {
+    tag: u32,
+    slots: Vec<Slot<V>>,
+    free_head: u32,
+    len: usize,
+}
+
+impl<V> Default for Arena<V> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<V> Arena<V> {
+    /// An empty arena with a fresh tag.
+    pub fn new() -> Self {
+        Arena {
+            tag: fresh_tag(),
+            slots: Vec::new(),
+            free_head: NONE,
+            len: 0,
+        }
+    }
+
+    /// Number of live values.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True when no value is stored.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Number of slots (live or free): the capacity in use.
+    pub fn slot_count(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// The handle the next `insert` will return (lets a caller store the handle
+    /// inside structures before inserting).
+    pub fn next_handle(&self) -> Handle {
+        if self.free_head != NONE {
+            let s = &self.slots[self.free_head as usize];
+            Handle {
+                tag: self.tag,
+                index: self.free_head,
+                generation: s.generation,
+            }
+        } else {
+            Handle {
+                tag: self.tag,
+                index: self.slots.len() as u32,
+                generation: 0,
+            }
+        }
+    }
+
+    /// Stores `value` and returns its handle. O(1) amortized.
+    pub fn insert(&mut self, value: V) -> Handle {
+        let h = self.next_handle();
+        if self.free_head != NONE {
+            let slot = &mut self.slots[self.free_head as usize];
+            let Entry::Vacant { next_free } = slot.entry else {
+                unreachable!("free list points at an occupied slot")
+            };
+            self.free_head = next_free;
+            slot.entry = Entry::Occupied(value);
+        } else {
+            assert!(self.slots.len() < NONE as usize, "arena full");
+            self.slots.push(Slot {
+                generation: 0,
+                entry: Entry::Occupied(value),
+            });
+        }
+        self.len += 1;
+        h
+    }
+
+    fn slot_of(&self, h: Handle) -> Result<usize> {
+        if h.tag != self.tag {
+            return Err(Error::StaleHandle);
+        }
+        match self.slots.get(h.index as usize) {
+            Some(s) if s.generation == h.generation && matches!(s.entry, Entry::Occupied(_)) => {
+                Ok(h.index as usize)
+            }
+            _ => Err(Error::StaleHandle),
+        }
+    }
+
+    /// True if `h` names a live value of this arena.
+    pub fn contains(&self, h: Handle) -> bool {
+        self.slot_of(h).is_ok()
+    }
+
+    /// The value of `h`.
+    pub fn get(&self, h: Handle) -> Result<&V> {
+        let i = self.slot_of(h)?;
+        match &self.slots[i].entry {
+            Entry::Occupied(v) => Ok(v),
+            Entry::Vacant { .. } => unreachable!(),
+        }
+    }
+
+    /// The value of `h`, mutably.
+    pub fn get_mut(&mut self, h: Handle) -> Result<&mut V> {
+        let i = self.slot_of(h)?;
+        match &mut self.slots[i].entry {
+            Entry::Occupied(v) => Ok(v),
+            Entry::Vacant { .. } => unreachable!(),
+        }
+    }
+
+    /// Removes and returns the value of `h`; the slot's generation advances so `h`
+    /// becomes stale. A slot whose generation would wrap is retired, never reused.
+    pub fn remove(&mut self, h: Handle) -> Result<V> {
+        let i = self.slot_of(h)?;
+        let slot = &mut self.slots[i];
+        slot.generation = slot.generation.wrapping_add(1);
+        let retire = slot.generation == 0;
+        let next_free = if retire { NONE } else { self.free_head };
+        let old = std::mem::replace(&mut slot.entry, Entry::Vacant { next_free });
+        if !retire {
+            self.free_head = i as u32;
+        }
+        self.len -= 1;
+        match old {
+            Entry::Occupied(v) => Ok(v),
+            Entry::Vacant { .. } => unreachable!(),
+        }
+    }
+
+    /// Removes everything and frees the memory; every earlier handle becomes stale
+    /// (the arena draws a new tag).
+    pub fn clear(&mut self) {
+        *self = Arena::new();
+    }
+
+    /// Live `(handle, value)` pairs in slot order.
+    pub fn iter(&self) -> impl Iterator<Item = (Handle, &V)> + '_ {
+        let tag = self.tag;
+        self.slots
+            .iter()
+            .enumerate()
+            .filter_map(move |(i, s)| match &s.entry {
+                Entry::Occupied(v) => Some((
+                    Handle {
+                        tag,
+                        index: i as u32,
+                        generation: s.generation,
+                    },
+                    v,
+                )),
+                Entry::Vacant { .. } => None,
+            })
+    }
+
+    /// Live `(handle, value)` pairs in slot order, mutably.
+    pub fn iter_mut(&mut self) -> impl Iterator<Item = (Handle, &mut V)> + '_ {
+        let tag = self.tag;
+        self.slots
+            .iter_mut()
+            .enumerate()
+            .filter_map(move |(i, s)| match &mut s.entry {
+                Entry::Occupied(v) => Some((
+                    Handle {
+                        tag,
+                        index: i as u32,
+                        generation: s.generation,
+                    },
+                    v,
+                )),
+                Entry::Vacant { .. } => None,
+            })
+    }
+
+    /// Bytes of heap memory held (capacity, not just length).
+    pub fn heap_bytes(&self) -> usize {
+        self.slots.capacity() * std::mem::size_of::<Slot<V>>()
+    }
+
+    /// Checks the free list and the live count.
+    pub fn validate(&self) -> Result<()> {
+        let live = self
+            .slots
+            .iter()
+            .filter(|s| matches!(s.entry, Entry::Occupied(_)))
+            .count();
+        if live != self.len {
+            return Err(Error::Invalid(format!(
+                "arena counts {} live slots but len is {}",
+                live, self.len
+            )));
+        }
+        let mut seen = 0usize;
+        let mut cur = self.free_head;
+        while cur != NONE {
+            let Some(s) = self.slots.get(cur as usize) else {
+                return Err(Error::Invalid("free list leaves the arena".into()));
+            };
+            let Entry::Vacant { next_free } = s.entry else {
+                return Err(Error::Invalid("free list reaches a live slot".into()));
+            };
+            seen += 1;
+            if seen > self.slots.len() {
+                return Err(Error::Invalid("free list has a cycle".into()));
+            }
+            cur = next_free;
+        }
+        Ok(())
+    }
+}
+
+/// A pool of nodes addressed by `u32`, with a free list: the arena for tree nodes.
+/// Freed slots are reused by later allocations; nothing is allocated per node once
+/// the pool has grown.
+#[derive(Clone, Debug)]
+pub struct Pool<N> {
+    nodes: Vec<N>,
+    free: Vec<u32>,
+}
+
+impl<N> Default for Pool<N> {
+    fn default() -> Self {
+        Pool {
+            nodes: Vec::new(),
+            free: Vec::new(),
+        }
+    }
+}
+
+impl<N> Pool<N> {
+    /// Stores `node`, reusing a freed slot when there is one. O(1) amortized.
+    pub fn alloc(&mut self, node: N) -> u32 {
+        if let Some(i) = self.free.pop() {
+            self.nodes[i as usize] = node;
+            i
+        } else {
+            self.nodes.push(node);
+            (self.nodes.len() - 1) as u32
+        }
+    }
+    /// Returns slot `i` to the free list. The caller must not use `i` again until
+    /// `alloc` hands it out.
+    pub fn free(&mut self, i: u32) {
+        debug_assert!((i as usize) < self.nodes.len());
+        self.free.push(i);
+    }
+    /// Live node count.
+    pub fn len(&self) -> usize {
+        self.nodes.len() - self.free.len()
+    }
+    /// True when no node is live.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Drops every node and frees the memory.
+    pub fn clear(&mut self) {
+        *self = Pool::default();
+    }
+    /// The free slots (for validation).
+    pub fn free_slots(&self) -> &[u32] {
+        &self.free
+    }
+    /// Total slots, live or free.
+    pub fn slot_count(&self) -> usize {
+        self.nodes.len()
+    }
+    /// Bytes of heap memory held.
+    pub fn heap_bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<N>() + self.free.capacity() * 4
+    }
+}
+
+impl<N> std::ops::Index<u32> for Pool<N> {
+    type Output = N;
+    fn index(&self, i: u32) -> &N {
+        &self.nodes[i as usize]
+    }
+}
+
+impl<N> std::ops::IndexMut<u32> for Pool<N> {
+    fn index_mut(&mut self, i: u32) -> &mut N {
+        &mut self.nodes[i as usize]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stale_and_foreign_handles_are_rejected() {
+        let mut a = Arena::new();
+        let mut b: Arena<i32> = Arena::new();
+        let h1 = a.insert(1);
+        assert_eq!(b.get(h1), Err(Error::StaleHandle));
+        assert_eq!(a.remove(h1), Ok(1));
+        assert_eq!(a.get(h1), Err(Error::StaleHandle));
+        let h2 = a.insert(2);
+        assert_eq!(h2.index(), h1.index(), "slot is reused");
+        assert_eq!(a.get(h1), Err(Error::StaleHandle));
+        assert_eq!(a.get(h2), Ok(&2));
+        a.clear();
+        assert_eq!(a.get(h2), Err(Error::StaleHandle));
+        let h3 = a.insert(3);
+        assert_eq!(h3.index(), 0);
+        assert_eq!(a.get(h2), Err(Error::StaleHandle));
+        a.validate().unwrap();
+        b.insert(5);
+        b.validate().unwrap();
+    }
+
+    #[test]
+    fn generation_wrap_retires_slot() {
+        let mut a = Arena::new();
+        let h = a.insert(0u8);
+        a.slots[0].generation = u32::MAX;
+        let h = Handle {
+            generation: u32::MAX,
+            ..h
+        };
+        a.remove(h).unwrap();
+        let h2 = a.insert(1);
+        assert_ne!(h2.index(), 0, "wrapped slot must not be reused");
+        a.validate().unwrap();
+    }
+}

@@ -1,0 +1,60 @@
+//! The crate's one error type.
+
+use std::fmt;
+
+/// Everything that can go wrong in a Proxima call. A call that returns an error
+/// leaves the structure it was called on exactly as it was.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum Error {
+    /// A coordinate, radius or matrix entry was NaN or infinite.
+    NonFinite {
+        /// Which input was not finite (for example `"sphere centre"`).
+        what: &'static str,
+    },
+    /// A radius was negative.
+    NegativeRadius {
+        /// The offending radius.
+        radius: f32,
+    },
+    /// An AABB whose `min` exceeds its `max` on some axis.
+    InvertedAabb,
+    /// A ray or segment direction of zero length.
+    ZeroDirection,
+    /// A ray's `max_t` was negative or NaN.
+    InvalidRayLength,
+    /// A handle that was removed, belongs to another index, or predates `clear()`.
+    StaleHandle,
+    /// A structure's invariant does not hold (from `validate()`).
+    Invalid(String),
+}
+
+/// `Result` with [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::NonFinite { what } => write!(f, "{what} is not finite"),
+            Error::NegativeRadius { radius } => write!(f, "negative radius {radius}"),
+            Error::InvertedAabb => write!(f, "AABB min exceeds max"),
+            Error::ZeroDirection => write!(f, "direction has zero length"),
+            Error::InvalidRayLength => write!(f, "ray max_t is negative or NaN"),
+            Error::StaleHandle => {
+                write!(f, "stale handle: removed, cleared, or from another index")
+            }
+            Error::Invalid(msg) => write!(f, "invariant violated: {msg}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// Checks that every component of `v` is finite.
+pub(crate) fn check_vec3(v: glam::Vec3, what: &'static str) -> Result<()> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::NonFinite { what })
+    }
+}

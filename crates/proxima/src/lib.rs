@@ -1,0 +1,22 @@
+//! # Proxima
+//!
+//! Spatial queries and collision detection for dynamic 3D scenes.
+//!
+//! - [`geom`]: the primitive shapes (`Sphere`, `Aabb`, `Ray`, `Segment`, `Plane`,
+//!   `Frustum`) and the one implementation of every closed overlap test between them.
+//! - [`broad`]: the [`broad::SpatialIndex`] trait over bounding spheres and its
+//!   indices: [`broad::BruteForce`] (the oracle) and the loose k-d tree of the first
+//!   source document, with more to come.
+//!
+//! Math types are [`glam`]'s (`f32`), re-exported as [`proxima::glam`](glam) so that
+//! users need not match versions by hand.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod arena;
+pub mod broad;
+mod error;
+pub mod geom;
+
+pub use error::{Error, Result};
+pub use glam;

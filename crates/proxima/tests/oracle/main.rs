@@ -1,0 +1,27 @@
+//! Oracle tests, written once and instantiated for every index: each index runs
+//! long random operation sequences against `BruteForce` in every scene.
+
+mod harness;
+
+use harness::{run, SceneParams, ALL_SCENES};
+use proxima::broad::BruteForce;
+
+/// Number of random operations per scene and seed.
+const OPS: usize = 6000;
+
+/// One `#[test]` per index: every scene, two seeds each.
+macro_rules! oracle_suite {
+    ($name:ident, $make:expr) => {
+        #[test]
+        fn $name() {
+            for scene in ALL_SCENES {
+                for seed in [1u64, 2] {
+                    run(scene, seed, OPS, $make);
+                }
+            }
+        }
+    };
+}
+
+// The oracle against itself still exercises validate(), handles and bad input.
+oracle_suite!(brute_force, |_: &SceneParams| BruteForce::new());

@@ -39,6 +39,7 @@ pub const ALL_SCENES: [Scene; 6] = [
 /// What an index constructor is told about the scene: the world box and the
 /// typical largest radius (objects may still exceed either).
 #[derive(Clone, Copy, Debug)]
+#[allow(dead_code)] // each index constructor reads what it needs
 pub struct SceneParams {
     pub world: Aabb,
     pub r_max: f32,

@@ -27,6 +27,9 @@ pub enum Error {
     StaleHandle,
     /// A structure's invariant does not hold (from `validate()`).
     Invalid(String),
+    /// A triangle mesh failed validation (no triangles, index out of range,
+    /// non-finite vertex).
+    InvalidMesh(String),
 }
 
 /// `Result` with [`Error`].
@@ -44,6 +47,7 @@ impl fmt::Display for Error {
                 write!(f, "stale handle: removed, cleared, or from another index")
             }
             Error::Invalid(msg) => write!(f, "invariant violated: {msg}"),
+            Error::InvalidMesh(msg) => write!(f, "invalid mesh: {msg}"),
         }
     }
 }

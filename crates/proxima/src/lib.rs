@@ -17,6 +17,7 @@ pub mod arena;
 pub mod broad;
 mod error;
 pub mod geom;
+pub mod narrow;
 
 pub use error::{Error, Result};
 pub use glam;

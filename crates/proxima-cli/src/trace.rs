@@ -53,7 +53,7 @@ pub enum Op {
     Query(Query),
 }
 
-/// Operation kinds, for timing tables.
+/// Operation kinds, for timing tables (`kind as usize` indexes [`Kind::ALL`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
     Insert,
@@ -371,6 +371,9 @@ mod tests {
         assert_eq!(t.ids, [7]);
         assert_eq!(t.max_live, 1);
         assert_eq!(t.query_count(), 5);
+        for (i, k) in Kind::ALL.iter().enumerate() {
+            assert_eq!(*k as usize, i);
+        }
     }
 
     #[test]

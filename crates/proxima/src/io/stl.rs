@@ -30,7 +30,8 @@ fn looks_ascii(data: &[u8]) -> bool {
         && (head.windows(5).any(|w| w == b"facet") || head.windows(8).any(|w| w == b"endsolid"))
 }
 
-/// Parses an STL file, binary or ASCII (by [`is_binary`], then the ASCII
+/// Parses an STL file, binary or ASCII (binary iff the size is 84 + 50 n with n
+/// the count at offset 80, even if it begins with `solid`; else the ASCII
 /// keywords). `name` is used in errors. Cost: linear in the file size, plus a
 /// hash map for welding.
 pub fn parse_stl(name: &str, data: &[u8]) -> Result<TriMesh> {

@@ -112,9 +112,10 @@ impl<T> LinearOctree<T> {
         // Delete emptied nodes upward (the root stays, as an empty leaf).
         while self.nodes[bottom].count == 0 {
             if bottom == self.root {
-                if !self.nodes[bottom].leaf {
-                    self.collapse(bottom);
-                }
+                // Only reachable with merging disabled: every child was deleted.
+                let root = &mut self.nodes[bottom];
+                debug_assert!(root.children.iter().all(|&c| c == NONE));
+                root.leaf = true;
                 break;
             }
             let parent = self.nodes[bottom].parent;

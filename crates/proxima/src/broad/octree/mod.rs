@@ -14,6 +14,9 @@ mod stats;
 mod update;
 mod validate;
 
+#[cfg(test)]
+mod tests;
+
 pub use code::{Face, LocationCode, MAX_DEPTH};
 pub use stats::OctreeStats;
 

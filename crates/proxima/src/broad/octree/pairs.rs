@@ -94,14 +94,39 @@ impl<T> LinearOctree<T> {
         let (na, nb): (&Node, &Node) = (&self.nodes[a.i], &self.nodes[b.i]);
         match (na.leaf, nb.leaf) {
             (true, true) => {
-                // Only spheres of `a` that reach `b`'s loose box can hit anything in b.
+                // Only spheres reaching the other leaf's loose box can overlap
+                // anything there: filter `b` once (into a stack buffer; a huge
+                // leaf at max depth falls back to no filter), then each of `a`.
+                let mut buf = [0u16; 64];
+                let mut m = 0;
+                let filtered = nb.items.len() <= buf.len();
+                if filtered {
+                    for (k, ib) in nb.items.iter().enumerate() {
+                        if overlap::sphere_aabb(&ib.sphere, &a.loose) {
+                            buf[m] = k as u16;
+                            m += 1;
+                        }
+                    }
+                    if m == 0 {
+                        return ControlFlow::Continue(());
+                    }
+                }
                 for ia in &na.items {
                     if !overlap::sphere_aabb(&ia.sphere, &b.loose) {
                         continue;
                     }
-                    for ib in &nb.items {
-                        if overlap::sphere_sphere(&ia.sphere, &ib.sphere) {
-                            self.report(ia.handle, ib.handle, f)?;
+                    if filtered {
+                        for &k in &buf[..m] {
+                            let ib = &nb.items[k as usize];
+                            if overlap::sphere_sphere(&ia.sphere, &ib.sphere) {
+                                self.report(ia.handle, ib.handle, f)?;
+                            }
+                        }
+                    } else {
+                        for ib in &nb.items {
+                            if overlap::sphere_sphere(&ia.sphere, &ib.sphere) {
+                                self.report(ia.handle, ib.handle, f)?;
+                            }
                         }
                     }
                 }

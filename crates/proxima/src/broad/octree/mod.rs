@@ -10,6 +10,7 @@ mod neighbors;
 mod node;
 mod pairs;
 mod query;
+mod ray;
 mod stats;
 mod update;
 mod validate;
@@ -21,8 +22,8 @@ pub use code::{Face, LocationCode, MAX_DEPTH};
 pub use stats::OctreeStats;
 
 use crate::arena::{Arena, Handle, Pool};
-use crate::broad::{Selection, SpatialIndex};
-use crate::geom::{Aabb, Sphere};
+use crate::broad::{RayHit, Selection, SpatialIndex};
+use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Result};
 use glam::Vec3;
 use node::{Node, Obj};
@@ -114,7 +115,9 @@ impl OctreeConfig {
 /// a subtree classified `Inside` (frustum, box) is reported without further tests,
 /// and frustum plane masks skip planes that already contain a parent.
 /// [`SpatialIndex::for_each_pair`] is a simultaneous traversal of the tree with
-/// itself, pruned by loose boxes. No query allocates.
+/// itself, pruned by loose boxes (on W1 at N = 100k about 4–5× faster than one
+/// sphere query per object, measured with `examples/octree_w1.rs`). The first ray
+/// hit is a front-to-back search. No query allocates.
 ///
 /// Costs: insert/remove O(depth) (plus a split or merge of ≤ `max_per_leaf`
 /// objects when one happens); a move within a leaf O(1), to an adjacent leaf O(1)
@@ -281,6 +284,12 @@ impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         self.pairs_tree(&mut f)
+    }
+
+    /// Front-to-back: children in order of entry along the ray, subtrees entered
+    /// after the best hit so far skipped.
+    fn ray_first_unchecked(&self, ray: &Ray) -> Option<RayHit> {
+        self.ray_first_tree(ray)
     }
 
     fn validate(&self) -> Result<()> {

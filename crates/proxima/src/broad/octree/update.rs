@@ -70,6 +70,10 @@ impl<T> LinearOctree<T> {
     /// down toward the centre (smaller neighbours); if not, go up to the first
     /// existing ancestor (a larger neighbour, or an inner node whose octant toward
     /// the centre is empty space and gets a new leaf).
+    ///
+    /// The seed guesses whether to search up or down first from the node's depth
+    /// relative to the tree's depth; here one map lookup of `n` decides it (a node:
+    /// same depth or down; absent: up), so no guess is needed.
     pub(super) fn resolve_neighbor(&mut self, n: LocationCode, key: u64) -> u32 {
         if let Some(&i) = self.map.get(&n.raw()) {
             if !self.nodes[i].leaf {

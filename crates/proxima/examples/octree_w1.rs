@@ -3,7 +3,7 @@
 //! per frame and bouncing off the walls; a frame = update all + find all pairs.
 //! Also compares the pair traversal with one sphere query per object.
 //!
-//! `cargo run --release -p proxima --example octree_w1 -- [N] [frames] [max_per_leaf]`
+//! `cargo run --release -p proxima --example octree_w1 -- [N] [frames] [max_per_leaf] [flat]`
 //! (criterion benches against peers live in the bench crate; this is a quick look.)
 
 use proxima::broad::{LinearOctree, OctreeConfig, SpatialIndex};
@@ -29,8 +29,14 @@ fn main() {
     let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(100_000);
     let frames: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(10);
     let mpl: u32 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(32);
-    let side = 4.0 * (n as f32).cbrt();
-    let world = Aabb::new(Vec3::ZERO, Vec3::splat(side));
+    // W1 by default; `flat` gives W2 (1000 x 1000 x 10).
+    let flat = args.get(4).is_some_and(|s| s == "flat");
+    let hi = if flat {
+        vec3(1000.0, 1000.0, 10.0)
+    } else {
+        Vec3::splat(4.0 * (n as f32).cbrt())
+    };
+    let world = Aabb::new(Vec3::ZERO, hi);
     let mut rng = Pcg64::seed_from_u64(1);
     let cfg = OctreeConfig {
         max_per_leaf: mpl,
@@ -41,9 +47,9 @@ fn main() {
     let mut objs: Vec<(Sphere, Vec3)> = (0..n)
         .map(|_| {
             let c = vec3(
-                rng.gen_range(0.0..side),
-                rng.gen_range(0.0..side),
-                rng.gen_range(0.0..side),
+                rng.gen_range(0.0..hi.x),
+                rng.gen_range(0.0..hi.y),
+                rng.gen_range(0.0..hi.z),
             );
             let v = vec3(
                 rng.gen_range(-1.0..1.0),
@@ -70,9 +76,9 @@ fn main() {
         for (h, (s, v)) in hs.iter().zip(objs.iter_mut()) {
             let mut c = s.center + *v;
             for a in 0..3 {
-                if c[a] < 0.0 || c[a] > side {
+                if c[a] < 0.0 || c[a] > hi[a] {
                     v[a] = -v[a];
-                    c[a] = c[a].clamp(0.0, side);
+                    c[a] = c[a].clamp(0.0, hi[a]);
                 }
             }
             s.center = c;

@@ -3,6 +3,7 @@
 //! | index | idea | source |
 //! |---|---|---|
 //! | [`BruteForce`] | scan everything; the oracle | — |
+//! | [`LinearOctree`] | sparse octree named by location codes in a hash map; O(1) face-neighbour codes, moves via neighbours, split/merge with hysteresis, loose bounds by max extent | seed 004 |
 //!
 //! Every index stores a [`Sphere`] and a user payload `T` per object and returns a
 //! generational [`Handle`]. Queries take `&self` (indices are `Send + Sync`, so
@@ -10,10 +11,12 @@
 //! early by returning [`ControlFlow::Break`].
 
 mod brute;
+pub mod octree;
 mod selection;
 
 pub use crate::arena::Handle;
 pub use brute::BruteForce;
+pub use octree::{LinearOctree, OctreeConfig};
 pub use selection::Selection;
 
 use crate::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};

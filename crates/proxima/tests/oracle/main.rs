@@ -25,3 +25,11 @@ macro_rules! oracle_suite {
 
 // The oracle against itself still exercises validate(), handles and bad input.
 oracle_suite!(brute_force, |_: &SceneParams| BruteForce::new());
+oracle_suite!(octree, |p: &SceneParams| {
+    let cfg = proxima::broad::OctreeConfig {
+        max_per_leaf: 4,
+        merge_below: 2,
+        max_depth: 12,
+    };
+    proxima::broad::LinearOctree::new(p.world, cfg).unwrap()
+});

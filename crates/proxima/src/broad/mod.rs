@@ -3,6 +3,7 @@
 //! | index | idea | source |
 //! |---|---|---|
 //! | [`BruteForce`] | scan everything; the oracle | — |
+//! | [`LooseKdTree`] | binary tree with overlapping children (shared border zone); each sphere in exactly one node | seed 000 (`SPHERE_SET_TREE`) |
 //!
 //! Every index stores a [`Sphere`] and a user payload `T` per object and returns a
 //! generational [`Handle`]. Queries take `&self` (indices are `Send + Sync`, so
@@ -10,10 +11,12 @@
 //! early by returning [`ControlFlow::Break`].
 
 mod brute;
+pub mod loose_kd;
 mod selection;
 
 pub use crate::arena::Handle;
 pub use brute::BruteForce;
+pub use loose_kd::LooseKdTree;
 pub use selection::Selection;
 
 use crate::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};

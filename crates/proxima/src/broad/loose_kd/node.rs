@@ -70,12 +70,14 @@ impl Node {
     pub fn child_bounds(&self, side: usize) -> (Aabb, Aabb) {
         let a = self.axis as usize;
         let (mut b, mut c) = (self.bbox, self.cell);
+        // The cell is intersected, not overwritten: `m` is the centre of the loose
+        // box, which need not lie inside this node's (tighter) cell.
         if side == 1 {
             b.min[a] = self.m - self.h;
-            c.min[a] = self.m;
+            c.min[a] = c.min[a].max(self.m);
         } else {
             b.max[a] = self.m + self.h;
-            c.max[a] = self.m;
+            c.max[a] = c.max[a].min(self.m);
         }
         (b, c)
     }

@@ -20,7 +20,7 @@
 use super::node::{FixedStack, NIL};
 use super::LooseKdTree;
 use crate::arena::Handle;
-use crate::geom::{overlap, Aabb, Sphere};
+use crate::geom::{overlap, Sphere};
 use std::ops::ControlFlow;
 
 /// An item carried down the tree: its sphere and arena slot.
@@ -116,22 +116,24 @@ impl<T> LooseKdTree<T> {
             buf.truncate(end);
         }
         if node.child[0] != NIL && node.child[1] != NIL {
-            self.cross(node.child[0], node.child[1], buf, f)?;
+            self.cross(n, node.child[0], node.child[1], buf, f)?;
         }
         ControlFlow::Continue(())
     }
 
-    /// Every pair between the subtrees of siblings `p` and `q`.
+    /// Every pair between the subtrees of `p` (negative child of `a`) and `q`
+    /// (positive child of `a`).
     fn cross(
         &self,
+        a: u32,
         p: u32,
         q: u32,
         buf: &mut Vec<Act>,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let base = buf.len();
-        let rq = self.region(&self.nodes[q]);
-        self.gather(p, &rq, buf);
+        let parent = &self.nodes[a];
+        self.gather(p, parent.axis as usize, self.pos_floor(parent), buf);
         if buf.len() > base {
             self.walk(q, base, buf, f)?;
         }
@@ -139,10 +141,15 @@ impl<T> LooseKdTree<T> {
         ControlFlow::Continue(())
     }
 
-    /// Appends the items of `p`'s subtree that touch `r`, skipping subtrees whose
-    /// region misses `r`. `r` contains every sphere of the other side, so an item
-    /// or subtree that misses it overlaps none of them.
-    fn gather(&self, p: u32, r: &Aabb, buf: &mut Vec<Act>) {
+    /// Appends the items of `p`'s subtree whose extent on `axis` reaches `floor`.
+    ///
+    /// Why this is the whole test: every sphere of the positive sibling has
+    /// `min_axis >= floor` (split rule, with slack), and on the other axes both
+    /// siblings share the bounds of their parent, so an item of `p` ending before
+    /// `floor` overlaps none of them. Inside `p`, only a negative child of a split
+    /// on the same axis lowers the upper bound of its spheres (to `m + h`), so it
+    /// is skipped when that bound is below `floor`; every other child may reach.
+    fn gather(&self, p: u32, axis: usize, floor: f32, buf: &mut Vec<Act>) {
         let mut stack = FixedStack::<u32>::new();
         stack.push(p);
         while let Some(n) = stack.pop() {
@@ -150,7 +157,7 @@ impl<T> LooseKdTree<T> {
             let mut it = node.first;
             while it != NIL {
                 let item = self.items.get_by_index(it).expect("listed item").1;
-                if overlap::sphere_aabb(&item.sphere, r) {
+                if item.sphere.center[axis] + item.sphere.radius >= floor {
                     buf.push(Act {
                         s: item.sphere,
                         idx: it,
@@ -158,10 +165,12 @@ impl<T> LooseKdTree<T> {
                 }
                 it = item.next;
             }
-            for c in node.child {
-                if c != NIL && overlap::aabb_aabb(&self.region(&self.nodes[c]), r) {
-                    stack.push(c);
-                }
+            let [neg, pos] = node.child;
+            if neg != NIL && (node.axis as usize != axis || self.neg_ceil(node) >= floor) {
+                stack.push(neg);
+            }
+            if pos != NIL {
+                stack.push(pos);
             }
         }
     }

@@ -25,6 +25,9 @@ pub enum Error {
     InvalidRayLength,
     /// A handle that was removed, belongs to another index, or predates `clear()`.
     StaleHandle,
+    /// A constructor parameter is out of its documented range (for example a
+    /// density outside `(0, 1]`).
+    InvalidParameter(String),
     /// A structure's invariant does not hold (from `validate()`).
     Invalid(String),
     /// A triangle mesh failed validation (no triangles, index out of range,
@@ -81,6 +84,7 @@ impl fmt::Display for Error {
             Error::StaleHandle => {
                 write!(f, "stale handle: removed, cleared, or from another index")
             }
+            Error::InvalidParameter(msg) => write!(f, "invalid parameter: {msg}"),
             Error::Invalid(msg) => write!(f, "invariant violated: {msg}"),
             Error::InvalidMesh(msg) => write!(f, "invalid mesh: {msg}"),
             Error::Io { file, msg } => write!(f, "{file}: {msg}"),

@@ -4,7 +4,7 @@
 mod harness;
 
 use harness::{run, SceneParams, ALL_SCENES};
-use proxima::broad::BruteForce;
+use proxima::broad::{BruteForce, LooseKdTree};
 
 /// Number of random operations per scene and seed.
 const OPS: usize = 6000;
@@ -33,3 +33,7 @@ oracle_suite!(octree, |p: &SceneParams| {
     };
     proxima::broad::LinearOctree::new(p.world, cfg).unwrap()
 });
+oracle_suite!(loose_kd, |p: &SceneParams| LooseKdTree::new(
+    p.world, p.r_max, 0.5
+)
+.unwrap());

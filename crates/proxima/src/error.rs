@@ -30,6 +30,9 @@ pub enum Error {
     /// A triangle mesh failed validation (no triangles, index out of range,
     /// non-finite vertex).
     InvalidMesh(String),
+    /// A pose that is not a rigid motion: non-finite, or a matrix that is not a
+    /// rotation (orthonormal with determinant +1, within a small tolerance).
+    InvalidPose(String),
 }
 
 /// `Result` with [`Error`].
@@ -48,6 +51,7 @@ impl fmt::Display for Error {
             }
             Error::Invalid(msg) => write!(f, "invariant violated: {msg}"),
             Error::InvalidMesh(msg) => write!(f, "invalid mesh: {msg}"),
+            Error::InvalidPose(msg) => write!(f, "invalid pose: {msg}"),
         }
     }
 }

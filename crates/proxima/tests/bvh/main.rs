@@ -6,8 +6,8 @@ use meshes::*;
 use proxima::geom::{Aabb, Ray, Segment, Sphere};
 use proxima::glam::{Affine3A, Vec3};
 use proxima::narrow::{
-    ray_triangle, BoundingVolume, BuildOptions, Bvh, Collider, Kdop14, Kdop18, Kdop26, Obb,
-    RotationUpdate, SplitRule, TriMesh,
+    ray_triangle, triangles_intersect, BoundingVolume, BuildOptions, Bvh, Collider, Kdop14, Kdop18,
+    Kdop26, Obb, RotationUpdate, SplitRule, TriMesh,
 };
 use proxima::Error;
 use rand::{Rng, SeedableRng};
@@ -326,4 +326,93 @@ fn refit_every_bv() {
     refit_after_deformation::<Kdop26>(4);
     refit_after_deformation::<Obb>(5);
     refit_after_deformation::<Sphere>(6);
+}
+
+/// Exact collision (all pairs and first contact) against brute force with
+/// `triangles_intersect`, for every BV type, split rule and rotation update.
+fn exact_matches_brute<BV: BoundingVolume>(a: &TriMesh, b: &TriMesh, poses: &[Affine3A]) -> usize {
+    let trees: Vec<(Bvh<BV>, Bvh<BV>)> = SPLITS
+        .iter()
+        .flat_map(|&s| [1, 3].map(move |l| opts(s, l)))
+        .map(|o| (Bvh::build(a, o).unwrap(), Bvh::build(b, o).unwrap()))
+        .collect();
+    let mut nonempty = 0;
+    for (k, pose) in poses.iter().enumerate() {
+        let want = brute_pairs(a, pose, b, triangles_intersect);
+        nonempty += !want.is_empty() as usize;
+        for (ta, tb) in &trees {
+            for rot in [RotationUpdate::Refit, RotationUpdate::Conservative] {
+                let mut c = Collider::<BV>::new(rot);
+                let got = c.all_pairs((ta, a), pose, (tb, b)).unwrap();
+                assert_eq!(
+                    sorted(got.pairs),
+                    want,
+                    "{} {:?} {rot:?} pose {k}",
+                    BV::NAME,
+                    ta.options()
+                );
+                let first = c.first_contact((ta, a), pose, (tb, b)).unwrap();
+                assert_eq!(first.pair.is_some(), !want.is_empty());
+                if let Some(p) = first.pair {
+                    assert!(want.binary_search(&p).is_ok());
+                }
+                assert!(first.counters.np <= got.counters.np);
+            }
+        }
+    }
+    nonempty
+}
+
+fn exact_every_bv(a: &TriMesh, b: &TriMesh, poses: &[Affine3A]) {
+    let n = exact_matches_brute::<Aabb>(a, b, poses);
+    assert!(
+        n * 4 >= poses.len(),
+        "only {n} of {} poses in contact",
+        poses.len()
+    );
+    exact_matches_brute::<Kdop14>(a, b, poses);
+    exact_matches_brute::<Kdop18>(a, b, poses);
+    exact_matches_brute::<Kdop26>(a, b, poses);
+    exact_matches_brute::<Obb>(a, b, poses);
+    exact_matches_brute::<Sphere>(a, b, poses);
+}
+
+#[test]
+fn exact_collision_procedural() {
+    let mut rng = Pcg64::seed_from_u64(77);
+    let a = torus(2.0, 0.6, 14, 8);
+    let b = terrain(4.0, 10, 3);
+    let poses: Vec<Affine3A> = (0..25)
+        .map(|_| {
+            random_pose(
+                &mut rng,
+                Vec3::new(-3.0, -3.0, -0.8),
+                Vec3::new(3.0, 3.0, 0.8),
+            )
+        })
+        .collect();
+    exact_every_bv(&a, &b, &poses);
+}
+
+#[test]
+fn exact_collision_touching_and_coplanar() {
+    // The same mesh at the identity (every triangle touches itself and its
+    // neighbours, coplanar), shifted by exactly one grid step (shared edges), and
+    // rotated by 90° about z onto itself.
+    let m = terrain(2.0, 6, 5);
+    let step = 4.0 / 6.0;
+    let poses = [
+        Affine3A::IDENTITY,
+        Affine3A::from_translation(Vec3::new(step, 0.0, 0.0)),
+        Affine3A::from_translation(Vec3::new(4.0, 0.0, 0.0)),
+        Affine3A::from_rotation_z(std::f32::consts::FRAC_PI_2),
+    ];
+    exact_every_bv(&m, &m, &poses);
+    let s = uv_sphere(Vec3::ZERO, 1.0, 10, 6);
+    let poses = [
+        Affine3A::IDENTITY,
+        Affine3A::from_translation(Vec3::new(2.0, 0.0, 0.0)),
+        Affine3A::from_translation(Vec3::new(1.9, 0.1, 0.0)),
+    ];
+    exact_every_bv(&s, &s, &poses);
 }

@@ -94,6 +94,13 @@ pub fn collide_first<BV: BoundingVolume>(
     Collider::new(RotationUpdate::Refit).first_contact(a, pose, b)
 }
 
+/// Checks that `pose` is a rigid motion as the collision queries need it: finite,
+/// and a matrix that is a rotation up to `1e-3` per entry of `RᵀR - I`, with a
+/// positive determinant. O(1).
+pub fn check_pose(pose: &Affine3A) -> Result<()> {
+    pose_deviation(pose).map(|_| ())
+}
+
 /// Checks a pose and returns the deviation of its matrix from a rotation.
 pub(crate) fn pose_deviation(pose: &Affine3A) -> Result<f32> {
     if !pose.matrix3.is_finite() || !pose.translation.is_finite() {

@@ -20,7 +20,8 @@ mod validate;
 
 pub use build::{BuildOptions, SplitRule};
 pub use collide::{
-    collide_all, collide_first, Collider, Contacts, CostCounters, FirstContact, RotationUpdate,
+    check_pose, collide_all, collide_first, Collider, Contacts, CostCounters, FirstContact,
+    RotationUpdate,
 };
 pub use ray::RayHit;
 pub use tree::{Bvh, Node};

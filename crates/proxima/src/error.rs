@@ -33,6 +33,41 @@ pub enum Error {
     /// A pose that is not a rigid motion: non-finite, or a matrix that is not a
     /// rotation (orthonormal with determinant +1, within a small tolerance).
     InvalidPose(String),
+    /// A mesh file could not be read (I/O failure, unknown format).
+    Io {
+        /// The file's path as given.
+        file: String,
+        /// What failed.
+        msg: String,
+    },
+    /// A mesh file is malformed: truncated, garbage, an index out of range, a
+    /// non-finite coordinate, a count that does not match the data…
+    Parse {
+        /// The file's path as given (or a caller-chosen name for in-memory data).
+        file: String,
+        /// Where: a line (text formats) or a byte offset (binary formats).
+        at: FileLocation,
+        /// What is wrong.
+        msg: String,
+    },
+}
+
+/// Where in a file a [`Error::Parse`] was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileLocation {
+    /// A 1-based line number of a text file.
+    Line(usize),
+    /// A 0-based byte offset into a binary file (or binary section).
+    Offset(u64),
+}
+
+impl fmt::Display for FileLocation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FileLocation::Line(n) => write!(f, "line {n}"),
+            FileLocation::Offset(o) => write!(f, "byte offset {o}"),
+        }
+    }
 }
 
 /// `Result` with [`Error`].
@@ -52,6 +87,8 @@ impl fmt::Display for Error {
             Error::Invalid(msg) => write!(f, "invariant violated: {msg}"),
             Error::InvalidMesh(msg) => write!(f, "invalid mesh: {msg}"),
             Error::InvalidPose(msg) => write!(f, "invalid pose: {msg}"),
+            Error::Io { file, msg } => write!(f, "{file}: {msg}"),
+            Error::Parse { file, at, msg } => write!(f, "{file}: {at}: {msg}"),
         }
     }
 }

@@ -17,7 +17,8 @@ pub mod arena;
 pub mod broad;
 mod error;
 pub mod geom;
+pub mod io;
 pub mod narrow;
 
-pub use error::{Error, Result};
+pub use error::{Error, FileLocation, Result};
 pub use glam;

@@ -60,6 +60,15 @@ impl BoundingVolume for Aabb {
         (self.min + m.0).cmple(o.max).all() && o.min.cmple(self.max + m.1).all()
     }
 
+    fn inflated(&self, slack: f32) -> Self {
+        self.grown(slack)
+    }
+
+    #[inline(always)]
+    fn overlaps_fixed(&self, o: &Self) -> bool {
+        self.min.cmple(o.max).all() && o.min.cmple(self.max).all()
+    }
+
     #[inline]
     fn size(&self) -> f32 {
         let e = self.extent();

@@ -68,6 +68,26 @@ fn project13(p: Vec3) -> [f32; 13] {
     ]
 }
 
+/// `min` without NaN handling (inputs are finite): one instruction.
+#[inline(always)]
+fn fmin(a: f32, b: f32) -> f32 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// `max` without NaN handling (inputs are finite).
+#[inline(always)]
+fn fmax(a: f32, b: f32) -> f32 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
 impl<const K: usize> Kdop<K> {
     const H: usize = K / 2;
 
@@ -109,8 +129,8 @@ impl<const K: usize> Kdop<K> {
         let pr = project13(p);
         for i in 0..Self::H {
             let v = pr[Self::axis_index(i)];
-            self.d[i] = self.d[i].min(v);
-            self.d[i + Self::H] = self.d[i + Self::H].max(v);
+            self.d[i] = fmin(self.d[i], v);
+            self.d[i + Self::H] = fmax(self.d[i + Self::H], v);
         }
     }
 
@@ -166,8 +186,8 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
     fn merge(&self, o: &Self) -> Self {
         let mut d = self.d;
         for i in 0..Self::H {
-            d[i] = d[i].min(o.d[i]);
-            d[i + Self::H] = d[i + Self::H].max(o.d[i + Self::H]);
+            d[i] = fmin(d[i], o.d[i]);
+            d[i + Self::H] = fmax(d[i + Self::H], o.d[i + Self::H]);
         }
         Kdop { d }
     }
@@ -213,6 +233,25 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
         for i in 0..Self::H {
             sep |= self.d[i] + m.d[i] > o.d[i + Self::H];
             sep |= o.d[i] > self.d[i + Self::H] + m.d[i + Self::H];
+        }
+        !sep
+    }
+
+    fn inflated(&self, slack: f32) -> Self {
+        let mut d = self.d;
+        for i in 0..Self::H {
+            d[i] -= slack;
+            d[i + Self::H] += slack;
+        }
+        Kdop { d }
+    }
+
+    #[inline(always)]
+    fn overlaps_fixed(&self, o: &Self) -> bool {
+        let mut sep = false;
+        for i in 0..Self::H {
+            sep |= self.d[i] > o.d[i + Self::H];
+            sep |= o.d[i] > self.d[i + Self::H];
         }
         !sep
     }

@@ -86,6 +86,15 @@ pub trait BoundingVolume: Copy + Debug + Send + Sync + 'static {
     /// (in the fixed frame), enlarged by the motion's slack. Conservative.
     fn overlaps(&self, motion: &Self::Motion, other: &Self) -> bool;
 
+    /// The volume grown by `slack` on every side (k-DOPs: every slab interval).
+    fn inflated(&self, slack: f32) -> Self;
+
+    /// Closed overlap of two volumes in the same frame, without slack (the caller
+    /// has [`inflated`](BoundingVolume::inflated) one of them).
+    fn overlaps_fixed(&self, other: &Self) -> bool {
+        self.overlaps(&Self::motion(&Affine3A::IDENTITY, 0.0), other)
+    }
+
     /// A size measure used to decide which tree to descend (the larger volume).
     /// Invariant under rigid motion for oriented volumes.
     fn size(&self) -> f32;

@@ -258,6 +258,13 @@ impl BoundingVolume for Obb {
         true
     }
 
+    fn inflated(&self, slack: f32) -> Self {
+        Obb {
+            half: self.half + Vec3::splat(slack),
+            ..*self
+        }
+    }
+
     #[inline]
     fn size(&self) -> f32 {
         2.0 * (self.half.x + self.half.y + self.half.z)

@@ -59,6 +59,10 @@ impl BoundingVolume for Sphere {
         (c - Vec3A::from(o.center)).length_squared() <= rs * rs
     }
 
+    fn inflated(&self, slack: f32) -> Self {
+        Sphere::new(self.center, self.radius + slack)
+    }
+
     #[inline]
     fn size(&self) -> f32 {
         self.radius

@@ -251,23 +251,16 @@ impl<BV: BoundingVolume> Collider<BV> {
         };
         let moved = |v: u32| pose.transform_point3(va[v as usize]);
         if BV::AXIS_ALIGNED && rotated {
-            let still = BV::motion(&Affine3A::IDENTITY, slack);
             match rotation {
                 RotationUpdate::Refit => {
                     world_vertices.clear();
                     world_vertices.extend(va.iter().map(|&v| pose.transform_point3(v)));
-                    c.nu = ta.world_volumes(world_vertices, world);
+                    c.nu = ta.world_volumes(world_vertices, slack, world);
                     let wv: &[Vec3] = world_vertices;
                     let corner = |v: u32| wv[v as usize];
-                    traverse(
-                        ta,
-                        &mut Precomputed(world),
-                        &still,
-                        tb,
-                        stack,
-                        &mut c.nv,
-                        |x, y| leaf(&corner, x, y),
-                    );
+                    traverse(ta, &mut Precomputed(world), tb, stack, &mut c.nv, |x, y| {
+                        leaf(&corner, x, y)
+                    });
                 }
                 RotationUpdate::Conservative => {
                     cache.clear();
@@ -275,26 +268,24 @@ impl<BV: BoundingVolume> Collider<BV> {
                     let mut src = Lazy {
                         nodes: &ta.nodes,
                         pose: *pose,
+                        slack,
                         cache,
                         updates: 0,
                     };
-                    traverse(ta, &mut src, &still, tb, stack, &mut c.nv, |x, y| {
+                    traverse(ta, &mut src, tb, stack, &mut c.nv, |x, y| {
                         leaf(&moved, x, y)
                     });
                     c.nu = src.updates;
                 }
             }
         } else {
-            let motion = BV::motion(pose, slack);
-            traverse(
-                ta,
-                &mut Local(&ta.nodes),
-                &motion,
-                tb,
-                stack,
-                &mut c.nv,
-                |x, y| leaf(&moved, x, y),
-            );
+            let mut src = Local {
+                nodes: &ta.nodes,
+                motion: BV::motion(pose, slack),
+            };
+            traverse(ta, &mut src, tb, stack, &mut c.nv, |x, y| {
+                leaf(&moved, x, y)
+            });
         }
         c.np = np;
         Ok(c)

@@ -41,22 +41,23 @@ impl<BV: BoundingVolume> Bvh<BV> {
     /// The seed's rotation update: every node's volume recomputed from the
     /// transformed vertices `world` (leaves from their triangles, internal nodes by
     /// merging), written to `out[i]` for node `i`. Exact for AABB and k-DOPs (the
-    /// k-DOP of a union is the merge of the k-DOPs). Returns the number of node
-    /// updates (`Nu`, all nodes). O(n).
-    pub(crate) fn world_volumes(&self, world: &[Vec3], out: &mut Vec<BV>) -> u64 {
+    /// k-DOP of a union is the merge of the k-DOPs). Leaves are enlarged by `slack`
+    /// (so every ancestor is too: the merge of enlarged volumes is the enlarged
+    /// merge). Returns the number of node updates (`Nu`, all nodes). O(n).
+    pub(crate) fn world_volumes(&self, world: &[Vec3], slack: f32, out: &mut Vec<BV>) -> u64 {
         out.clear();
         out.extend(self.nodes.iter().map(|n| n.bv));
-        let mut tri: Vec<[Vec3; 3]> = Vec::new();
         for i in (0..self.nodes.len()).rev() {
             let n = &self.nodes[i];
             out[i] = if n.is_leaf() {
-                tri.clear();
-                tri.extend(
-                    self.tris[n.triangle_range()]
-                        .iter()
-                        .map(|t| t.map(|v| world[v as usize])),
-                );
-                BV::from_triangles(&tri)
+                // Per triangle, merged: exact for k-DOPs, no scratch buffer.
+                let mut tris = self.tris[n.triangle_range()].iter();
+                let corners = |t: &[u32; 3]| t.map(|v| world[v as usize]);
+                let mut bv = BV::from_points(&corners(tris.next().expect("leaf is non-empty")));
+                for t in tris {
+                    bv = bv.merge(&BV::from_points(&corners(t)));
+                }
+                bv.inflated(slack)
             } else {
                 let (l, r) = n.children(i as u32);
                 out[l as usize].merge(&out[r as usize])

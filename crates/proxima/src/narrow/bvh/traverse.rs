@@ -3,51 +3,81 @@
 use super::tree::Bvh;
 use crate::narrow::bv::BoundingVolume;
 
-/// Where the moving tree's volumes come from during a traversal.
+/// Where the moving tree's volumes come from during a traversal, and how they are
+/// tested against the fixed tree's.
 pub(crate) trait VolumeSource<BV> {
-    /// The volume of node `i` of the moving tree, in the frame `motion` expects.
-    fn volume(&mut self, i: usize) -> BV;
+    /// Whether node `i` of the moving tree overlaps `other` (a fixed-tree volume).
+    fn overlaps(&mut self, i: usize, other: &BV) -> bool;
+    /// The size of node `i` (to pick the tree to descend).
+    fn size(&mut self, i: usize) -> f32;
 }
 
-/// The tree's own volumes (a motion does the moving).
-pub(crate) struct Local<'a, BV>(pub &'a [super::Node<BV>]);
+/// The tree's own volumes, moved by a prepared motion inside the test.
+pub(crate) struct Local<'a, BV: BoundingVolume> {
+    pub nodes: &'a [super::Node<BV>],
+    pub motion: BV::Motion,
+}
 
-impl<BV: Copy> VolumeSource<BV> for Local<'_, BV> {
-    #[inline]
-    fn volume(&mut self, i: usize) -> BV {
-        self.0[i].bv
+impl<BV: BoundingVolume> VolumeSource<BV> for Local<'_, BV> {
+    #[inline(always)]
+    fn overlaps(&mut self, i: usize, other: &BV) -> bool {
+        self.nodes[i].bv.overlaps(&self.motion, other)
+    }
+    #[inline(always)]
+    fn size(&mut self, i: usize) -> f32 {
+        self.nodes[i].bv.size()
     }
 }
 
-/// Volumes precomputed per node (the exact refit).
+/// Volumes precomputed per node in the fixed frame, already enlarged by the slack
+/// (the exact refit): the test is plain interval comparisons.
 pub(crate) struct Precomputed<'a, BV>(pub &'a [BV]);
 
-impl<BV: Copy> VolumeSource<BV> for Precomputed<'_, BV> {
-    #[inline]
-    fn volume(&mut self, i: usize) -> BV {
-        self.0[i]
+impl<BV: BoundingVolume> VolumeSource<BV> for Precomputed<'_, BV> {
+    #[inline(always)]
+    fn overlaps(&mut self, i: usize, other: &BV) -> bool {
+        self.0[i].overlaps_fixed(other)
+    }
+    #[inline(always)]
+    fn size(&mut self, i: usize) -> f32 {
+        self.0[i].size()
     }
 }
 
-/// Volumes transformed on first use ([`BoundingVolume::transformed`]), counting
-/// each transform as one node update.
+/// Volumes transformed on first use ([`BoundingVolume::transformed`]) and enlarged
+/// by the slack, counting each as one node update.
 pub(crate) struct Lazy<'a, BV> {
     pub nodes: &'a [super::Node<BV>],
     pub pose: glam::Affine3A,
+    pub slack: f32,
     pub cache: &'a mut Vec<Option<BV>>,
     pub updates: u64,
 }
 
+impl<BV: BoundingVolume> Lazy<'_, BV> {
+    #[inline]
+    fn get(&mut self, i: usize) -> &BV {
+        if self.cache[i].is_none() {
+            self.cache[i] = Some(
+                self.nodes[i]
+                    .bv
+                    .transformed(&self.pose)
+                    .inflated(self.slack),
+            );
+            self.updates += 1;
+        }
+        self.cache[i].as_ref().expect("just filled")
+    }
+}
+
 impl<BV: BoundingVolume> VolumeSource<BV> for Lazy<'_, BV> {
     #[inline]
-    fn volume(&mut self, i: usize) -> BV {
-        if let Some(v) = self.cache[i] {
-            return v;
-        }
-        let v = self.nodes[i].bv.transformed(&self.pose);
-        self.cache[i] = Some(v);
-        self.updates += 1;
-        v
+    fn overlaps(&mut self, i: usize, other: &BV) -> bool {
+        self.get(i).overlaps_fixed(other)
+    }
+    #[inline]
+    fn size(&mut self, i: usize) -> f32 {
+        self.get(i).size()
     }
 }
 
@@ -60,7 +90,6 @@ impl<BV: BoundingVolume> VolumeSource<BV> for Lazy<'_, BV> {
 pub(crate) fn traverse<BV: BoundingVolume>(
     a: &Bvh<BV>,
     src: &mut impl VolumeSource<BV>,
-    motion: &BV::Motion,
     b: &Bvh<BV>,
     stack: &mut Vec<(u32, u32)>,
     nv: &mut u64,
@@ -69,10 +98,9 @@ pub(crate) fn traverse<BV: BoundingVolume>(
     stack.clear();
     stack.push((0, 0));
     while let Some((ia, ib)) = stack.pop() {
-        let va = src.volume(ia as usize);
         let nb = &b.nodes[ib as usize];
         *nv += 1;
-        if !va.overlaps(motion, &nb.bv) {
+        if !src.overlaps(ia as usize, &nb.bv) {
             continue;
         }
         let na = &a.nodes[ia as usize];
@@ -85,7 +113,7 @@ pub(crate) fn traverse<BV: BoundingVolume>(
             (false, true) => push_a(stack, na, ia, ib),
             (true, false) => push_b(stack, nb, ia, ib),
             (false, false) => {
-                if va.size() >= nb.bv.size() {
+                if src.size(ia as usize) >= nb.bv.size() {
                     push_a(stack, na, ia, ib)
                 } else {
                     push_b(stack, nb, ia, ib)

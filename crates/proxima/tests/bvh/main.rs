@@ -1,6 +1,7 @@
 //! BVH tests against brute force: structure, traversal, collision, ray casts, refit.
 
 mod meshes;
+mod real;
 
 use meshes::*;
 use proxima::geom::{Aabb, Ray, Segment, Sphere};

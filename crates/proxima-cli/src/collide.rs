@@ -4,7 +4,7 @@
 //! ```text
 //! proxima collide A B [--bv aabb|kdop14|kdop18|kdop26|obb|sphere]
 //!                     [--split mean|median|sah] [--leaf N]
-//!                     [--rotation refit|conservative] [--first]
+//!                     [--rotation auto|refit|conservative] [--first]
 //!                     [--poses FILE] [--stats] [--time]
 //! ```
 //! Each pose (12 numbers per line: a row-major rotation, then a translation; `#`
@@ -25,7 +25,7 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 const USAGE: &str = "usage: proxima collide A B [--bv aabb|kdop14|kdop18|kdop26|obb|sphere] \
-[--split mean|median|sah] [--leaf N] [--rotation refit|conservative] [--first] \
+[--split mean|median|sah] [--leaf N] [--rotation auto|refit|conservative] [--first] \
 [--poses FILE] [--stats] [--time]";
 
 /// Parsed command line.
@@ -48,7 +48,7 @@ fn parse_args(args: &[String]) -> Result<Args, String> {
         b: String::new(),
         bv: "kdop18".into(),
         build: BuildOptions::default(),
-        rotation: RotationUpdate::Refit,
+        rotation: RotationUpdate::Auto,
         first: false,
         poses: None,
         stats: false,
@@ -86,6 +86,7 @@ fn parse_args(args: &[String]) -> Result<Args, String> {
             }
             "--rotation" => {
                 out.rotation = match value("--rotation")?.as_str() {
+                    "auto" => RotationUpdate::Auto,
                     "refit" => RotationUpdate::Refit,
                     "conservative" => RotationUpdate::Conservative,
                     v => return Err(format!("unknown rotation update '{v}'\n{USAGE}")),

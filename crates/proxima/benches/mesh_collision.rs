@@ -133,7 +133,10 @@ fn bench(c: &mut Criterion) {
         b: &env,
         poses: &p,
     };
-    let median = BuildOptions::default();
+    let median = BuildOptions {
+        split: SplitRule::Median,
+        leaf_size: 1,
+    };
     every_bv(c, &case, median, "median");
     let sah = BuildOptions {
         split: SplitRule::Sah,
@@ -158,8 +161,9 @@ fn bench(c: &mut Criterion) {
         b: &ribs,
         poses: &p,
     };
-    run_all::<Kdop18>(c, &case, median, RotationUpdate::Refit, "median");
-    run_all::<Obb>(c, &case, median, RotationUpdate::Refit, "median");
+    run_all::<Kdop18>(c, &case, sah, RotationUpdate::Refit, "sah-refit");
+    run_all::<Kdop18>(c, &case, sah, RotationUpdate::Auto, "sah-auto");
+    run_all::<Obb>(c, &case, sah, RotationUpdate::Auto, "sah");
 }
 
 criterion_group! {

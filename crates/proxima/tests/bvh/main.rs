@@ -342,7 +342,11 @@ fn exact_matches_brute<BV: BoundingVolume>(a: &TriMesh, b: &TriMesh, poses: &[Af
         let want = brute_pairs(a, pose, b, triangles_intersect);
         nonempty += !want.is_empty() as usize;
         for (ta, tb) in &trees {
-            for rot in [RotationUpdate::Refit, RotationUpdate::Conservative] {
+            for rot in [
+                RotationUpdate::Refit,
+                RotationUpdate::Conservative,
+                RotationUpdate::Auto,
+            ] {
                 let mut c = Collider::<BV>::new(rot);
                 let got = c.all_pairs((ta, a), pose, (tb, b)).unwrap();
                 assert_eq!(

@@ -18,11 +18,11 @@ pub enum SplitRule {
     /// side would be empty). Adapts to clusters; depth is not bounded by `log n`.
     Mean,
     /// Plane through the median: a balanced tree of depth `⌈log2(n / leaf)⌉ + 1`.
-    #[default]
     Median,
     /// Binned surface-area heuristic (16 bins on each axis, AABB areas): the plane
-    /// minimizing `area(L)·|L| + area(R)·|R|`. Not in the seed; usually the fastest
-    /// tree to traverse.
+    /// minimizing `area(L)·|L| + area(R)·|R|`. Not in the seed; the default, since
+    /// its trees need 35–45 % fewer volume tests than the median's on W5.
+    #[default]
     Sah,
 }
 
@@ -36,10 +36,10 @@ pub struct BuildOptions {
 }
 
 impl Default for BuildOptions {
-    /// Median split, one triangle per leaf (the seed's tree, and FCL's default).
+    /// SAH split, one triangle per leaf (FCL's leaf size).
     fn default() -> Self {
         BuildOptions {
-            split: SplitRule::Median,
+            split: SplitRule::Sah,
             leaf_size: 1,
         }
     }

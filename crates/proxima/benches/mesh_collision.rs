@@ -146,10 +146,11 @@ fn bench(c: &mut Criterion) {
     run_all::<Kdop18>(
         c,
         &case,
-        median,
+        sah,
         RotationUpdate::Conservative,
-        "median-conserv",
+        "sah-conservative",
     );
+    run_all::<Kdop18>(c, &case, sah, RotationUpdate::Auto, "sah-auto");
 
     let skin = data("SKINbody.stl");
     let ribs = data("BONERibcage.stl");

@@ -30,6 +30,9 @@ pub enum Error {
     /// A triangle mesh failed validation (no triangles, index out of range,
     /// non-finite vertex).
     InvalidMesh(String),
+    /// A constructor parameter out of its range (for example a cell size that is
+    /// not positive, or a grid that would need too many cells).
+    InvalidParameter(String),
 }
 
 /// `Result` with [`Error`].
@@ -48,6 +51,7 @@ impl fmt::Display for Error {
             }
             Error::Invalid(msg) => write!(f, "invariant violated: {msg}"),
             Error::InvalidMesh(msg) => write!(f, "invalid mesh: {msg}"),
+            Error::InvalidParameter(msg) => write!(f, "invalid parameter: {msg}"),
         }
     }
 }

@@ -3,6 +3,7 @@
 //! | index | idea | source |
 //! |---|---|---|
 //! | [`BruteForce`] | scan everything; the oracle | — |
+//! | [`UniformGrid2d`] | uniform grid on the XY plane for flat worlds; objects referenced from every covered cell | seed 000 |
 //!
 //! Every index stores a [`Sphere`] and a user payload `T` per object and returns a
 //! generational [`Handle`]. Queries take `&self` (indices are `Send + Sync`, so
@@ -10,10 +11,13 @@
 //! early by returning [`ControlFlow::Break`].
 
 mod brute;
+mod cell_list;
+mod grid2d;
 mod selection;
 
 pub use crate::arena::Handle;
 pub use brute::BruteForce;
+pub use grid2d::UniformGrid2d;
 pub use selection::Selection;
 
 use crate::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};

@@ -4,7 +4,7 @@
 mod harness;
 
 use harness::{run, SceneParams, ALL_SCENES};
-use proxima::broad::BruteForce;
+use proxima::broad::{BruteForce, UniformGrid2d};
 
 /// Number of random operations per scene and seed.
 const OPS: usize = 6000;
@@ -25,3 +25,7 @@ macro_rules! oracle_suite {
 
 // The oracle against itself still exercises validate(), handles and bad input.
 oracle_suite!(brute_force, |_: &SceneParams| BruteForce::new());
+oracle_suite!(grid2d, |p: &SceneParams| UniformGrid2d::new(
+    p.world, p.r_max
+)
+.unwrap());

@@ -3,6 +3,7 @@
 //! | index | idea | source |
 //! |---|---|---|
 //! | [`BruteForce`] | scan everything; the oracle | — |
+//! | [`HashGrid`] | unbounded 3D hashed grid; huge objects in an oversized list | seed 000 (3D) |
 //! | [`UniformGrid2d`] | uniform grid on the XY plane for flat worlds; objects referenced from every covered cell | seed 000 |
 //!
 //! Every index stores a [`Sphere`] and a user payload `T` per object and returns a
@@ -13,11 +14,13 @@
 mod brute;
 mod cell_list;
 mod grid2d;
+mod hash_grid;
 mod selection;
 
 pub use crate::arena::Handle;
 pub use brute::BruteForce;
 pub use grid2d::UniformGrid2d;
+pub use hash_grid::HashGrid;
 pub use selection::Selection;
 
 use crate::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};

@@ -1,42 +1,33 @@
-//! The contents of one grid cell, shared by [`UniformGrid2d`](super::UniformGrid2d)
-//! and [`HashGrid`](super::HashGrid): a compact list of references plus a loose box.
+//! Shared pieces of [`UniformGrid2d`](super::UniformGrid2d) and
+//! [`HashGrid`](super::HashGrid): the compact reference list of a cell, and the
+//! global bounds that stand in for per-cell loose boxes.
 //!
-//! Each reference carries a copy of the object's sphere and the lowest cell of the
-//! object's cell range, so the hot loops (pairs, range queries) read one contiguous
-//! array and never chase a pointer until they report.
+//! Cells hold only `(slot, lowest cell)` references; the spheres live in one dense
+//! array indexed by slot. So an update that keeps an object's cell range writes
+//! one sphere and touches no cell at all — the common case in a moving scene.
 
 use crate::geom::{Aabb, Sphere};
 
 /// One reference from a cell to an object.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct CellEntry<L> {
-    /// Copy of the object's sphere (kept equal to the stored one by `update`).
-    pub sphere: Sphere,
-    /// The object's arena slot (`Handle::index`).
+    /// The object's arena slot (`Handle::index`), also its index in the sphere array.
     pub slot: u32,
     /// Lowest cell of the object's cell range: the once-only reporting rules compare
-    /// it with the cell being scanned.
+    /// it with the cell being scanned, without touching the sphere.
     pub lo: L,
 }
 
-/// A cell: its references and a loose box that contains the AABB of every
-/// referenced sphere.
-///
-/// The loose box grows when a reference is added or its sphere moves, and is
-/// recomputed exactly when a reference leaves (that scan is needed anyway to find
-/// it). So it is always conservative, tight after removals, and reset to
-/// [`Aabb::EMPTY`] when the cell empties.
+/// A cell's references.
 #[derive(Clone, Debug)]
 pub(crate) struct CellList<L> {
     pub entries: Vec<CellEntry<L>>,
-    pub loose: Aabb,
 }
 
 impl<L> Default for CellList<L> {
     fn default() -> Self {
         CellList {
             entries: Vec::new(),
-            loose: Aabb::EMPTY,
         }
     }
 }
@@ -44,74 +35,129 @@ impl<L> Default for CellList<L> {
 impl<L: Copy> CellList<L> {
     /// Adds a reference. O(1) amortized.
     #[inline]
-    pub fn push(&mut self, sphere: Sphere, slot: u32, lo: L) {
-        self.entries.push(CellEntry { sphere, slot, lo });
-        self.loose = self.loose.union(&sphere.aabb());
+    pub fn push(&mut self, slot: u32, lo: L) {
+        self.entries.push(CellEntry { slot, lo });
     }
 
-    /// Removes the reference to `slot` and recomputes the loose box. O(len).
-    /// Returns false if the cell did not reference `slot`.
-    pub fn remove(&mut self, slot: u32) -> bool {
-        let Some(i) = self.entries.iter().position(|e| e.slot == slot) else {
-            return false;
-        };
-        self.entries.swap_remove(i);
-        self.loose = self
-            .entries
-            .iter()
-            .fold(Aabb::EMPTY, |b, e| b.union(&e.sphere.aabb()));
-        true
-    }
-
-    /// Replaces the sphere (and lowest cell) of the reference to `slot`; the loose
-    /// box grows to cover the new sphere. O(position of the reference).
+    /// Removes the reference to `slot`. O(len). False if there was none.
     #[inline]
-    pub fn overwrite(&mut self, slot: u32, sphere: Sphere, lo: L) -> bool {
-        let Some(e) = self.entries.iter_mut().find(|e| e.slot == slot) else {
-            return false;
-        };
-        e.sphere = sphere;
-        e.lo = lo;
-        self.loose = self.loose.union(&sphere.aabb());
-        true
+    pub fn remove(&mut self, slot: u32) -> bool {
+        match self.entries.iter().position(|e| e.slot == slot) {
+            Some(i) => {
+                self.entries.swap_remove(i);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Sets the lowest cell stored with the reference to `slot`. False if none.
+    #[inline]
+    pub fn set_lo(&mut self, slot: u32, lo: L) -> bool {
+        match self.entries.iter_mut().find(|e| e.slot == slot) {
+            Some(e) => {
+                e.lo = lo;
+                true
+            }
+            None => false,
+        }
     }
 
     /// Heap bytes of the reference list (capacity).
     pub fn heap_bytes(&self) -> usize {
         self.entries.capacity() * std::mem::size_of::<CellEntry<L>>()
     }
+}
 
-    /// True if the loose box contains the AABB of every referenced sphere.
-    pub fn loose_is_valid(&self) -> bool {
-        if self.entries.is_empty() {
-            return self.loose == Aabb::EMPTY;
+/// Bounds on every sphere stored since the index was created, cleared or emptied:
+/// the largest radius and the union of the boxes. They only grow (shrinking would
+/// need a scan), which keeps them conservative at O(1) per update.
+///
+/// A cell's loose box — a box containing every sphere it references — is then
+/// the cell grown by twice the largest radius (a referenced sphere's footprint
+/// meets the cell), clipped to the union box; border cells, which also hold the
+/// clamped objects from beyond, reach out to the union box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Reach {
+    pub max_radius: f32,
+    pub extent: Aabb,
+}
+
+impl Default for Reach {
+    fn default() -> Self {
+        Reach {
+            max_radius: 0.0,
+            extent: Aabb::EMPTY,
         }
-        self.entries
-            .iter()
-            .all(|e| self.loose.contains_aabb(&e.sphere.aabb()))
+    }
+}
+
+impl Reach {
+    /// Grows the bounds to cover `s`.
+    #[inline]
+    pub fn include(&mut self, s: &Sphere) {
+        self.max_radius = self.max_radius.max(s.radius);
+        self.extent = self.extent.union(&s.aabb());
+    }
+
+    /// True if the bounds cover `s`.
+    pub fn covers(&self, s: &Sphere) -> bool {
+        s.radius <= self.max_radius && self.extent.contains_aabb(&s.aabb())
+    }
+
+    /// The loose box of a cell spanning `[min, max]`; `open_lo`/`open_hi` mark the
+    /// axes on which the cell is a border cell that also holds everything beyond.
+    #[inline]
+    pub fn loose(
+        &self,
+        min: glam::Vec3,
+        max: glam::Vec3,
+        open_lo: glam::BVec3,
+        open_hi: glam::BVec3,
+    ) -> Aabb {
+        let r = glam::Vec3::splat(2.0 * self.max_radius);
+        let lo = glam::Vec3::select(open_lo, self.extent.min, (min - r).max(self.extent.min));
+        let hi = glam::Vec3::select(open_hi, self.extent.max, (max + r).min(self.extent.max));
+        Aabb::new(lo, hi)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::{vec3, Vec3};
+    use glam::{vec3, BVec3, Vec3};
 
     #[test]
-    fn loose_box_grows_and_shrinks() {
+    fn references_and_reach() {
         let mut c: CellList<u8> = CellList::default();
-        c.push(Sphere::new(Vec3::ZERO, 1.0), 0, 0);
-        c.push(Sphere::new(vec3(5.0, 0.0, 0.0), 1.0), 1, 0);
-        assert_eq!(c.loose.max.x, 6.0);
-        assert!(c.overwrite(1, Sphere::new(vec3(9.0, 0.0, 0.0), 1.0), 0));
-        assert_eq!(c.loose.max.x, 10.0);
-        assert!(c.loose_is_valid());
-        assert!(c.remove(1));
-        assert_eq!(c.loose, Sphere::new(Vec3::ZERO, 1.0).aabb());
-        assert!(!c.remove(1));
-        assert!(!c.overwrite(1, Sphere::default(), 0));
-        assert!(c.remove(0));
-        assert_eq!(c.loose, Aabb::EMPTY);
-        assert!(c.loose_is_valid());
+        c.push(3, 0);
+        c.push(5, 1);
+        assert!(c.set_lo(5, 7));
+        assert_eq!(c.entries[1].lo, 7);
+        assert!(c.remove(3));
+        assert!(!c.remove(3));
+        assert!(!c.set_lo(3, 0));
+        assert_eq!(c.entries, vec![CellEntry { slot: 5, lo: 7 }]);
+
+        let mut r = Reach::default();
+        let s = Sphere::new(vec3(5.0, 5.0, 5.0), 1.0);
+        r.include(&s);
+        r.include(&Sphere::new(vec3(-50.0, 5.0, 5.0), 0.5));
+        assert!(r.covers(&s));
+        assert!(!r.covers(&Sphere::new(Vec3::ZERO, 2.0)));
+        let b = r.loose(
+            Vec3::splat(4.0),
+            Vec3::splat(6.0),
+            BVec3::FALSE,
+            BVec3::FALSE,
+        );
+        assert_eq!(b, Aabb::new(vec3(2.0, 4.0, 4.0), vec3(6.0, 6.0, 6.0)));
+        let b = r.loose(
+            Vec3::splat(4.0),
+            Vec3::splat(6.0),
+            BVec3::TRUE,
+            BVec3::FALSE,
+        );
+        assert_eq!(b.min, vec3(-50.5, 4.0, 4.0));
     }
 }

@@ -2,16 +2,15 @@
 
 use super::cells::CellRect;
 use super::UniformGrid2d;
-use crate::geom::Sphere;
 
 impl<T> UniformGrid2d<T> {
     /// References `slot` from every cell of `rect`.
-    pub(super) fn link(&mut self, slot: u32, sphere: &Sphere, rect: CellRect) {
+    pub(super) fn link(&mut self, slot: u32, rect: CellRect) {
         let lo = rect.lo();
         for y in rect.y0..=rect.y1 {
             for x in rect.x0..=rect.x1 {
                 let i = self.geom.index(x, y);
-                self.cells[i].push(*sphere, slot, lo);
+                self.cells[i].push(slot, lo);
             }
         }
         self.refs += rect.area();
@@ -29,28 +28,27 @@ impl<T> UniformGrid2d<T> {
         self.refs -= rect.area();
     }
 
-    /// Moves `slot` from the cells of `old` to those of `new`. When the range is
-    /// unchanged (the common case for small moves) only the sphere copies change.
-    pub(super) fn relink(&mut self, slot: u32, sphere: &Sphere, old: CellRect, new: CellRect) {
+    /// Moves `slot` from the cells of `old` to those of a different `new`: drops
+    /// the references that leave, adds those that arrive, and updates the lowest
+    /// cell stored in those that stay.
+    pub(super) fn relink(&mut self, slot: u32, old: CellRect, new: CellRect) {
         let lo = new.lo();
         for y in old.y0..=old.y1 {
             for x in old.x0..=old.x1 {
                 let i = self.geom.index(x, y);
                 let found = if new.contains(x, y) {
-                    self.cells[i].overwrite(slot, *sphere, lo)
+                    self.cells[i].set_lo(slot, lo)
                 } else {
                     self.cells[i].remove(slot)
                 };
                 debug_assert!(found, "missing grid reference");
             }
         }
-        if old != new {
-            for y in new.y0..=new.y1 {
-                for x in new.x0..=new.x1 {
-                    if !old.contains(x, y) {
-                        let i = self.geom.index(x, y);
-                        self.cells[i].push(*sphere, slot, lo);
-                    }
+        for y in new.y0..=new.y1 {
+            for x in new.x0..=new.x1 {
+                if !old.contains(x, y) {
+                    let i = self.geom.index(x, y);
+                    self.cells[i].push(slot, lo);
                 }
             }
         }

@@ -15,7 +15,7 @@ mod ray;
 mod validate;
 
 use crate::arena::{Arena, Handle};
-use crate::broad::cell_list::CellList;
+use crate::broad::cell_list::{CellList, Reach};
 use crate::broad::{RayHit, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Result};
@@ -25,10 +25,10 @@ use std::ops::ControlFlow;
 /// Default cap on the number of cells chosen by [`UniformGrid2d::new`].
 pub const DEFAULT_MAX_CELLS: usize = 1 << 20;
 
-/// A stored object: its sphere, the cells it is referenced from, its payload.
+/// A stored object: the cells it is referenced from and its payload (the sphere
+/// is in the dense `spheres` array).
 #[derive(Clone, Debug)]
 struct Item<T> {
-    sphere: Sphere,
     rect: CellRect,
     value: T,
 }
@@ -37,9 +37,13 @@ struct Item<T> {
 /// grid on the XY plane" for worlds with `dz << dx, dy`).
 ///
 /// Every object is referenced from each cell its XY footprint (the bounding square
-/// of its circle) covers. A cell holds a compact list of references, each with a
-/// copy of the sphere, so pair finding and range queries scan contiguous memory.
+/// of its circle) covers. A cell holds a compact list of 8-byte references (slot
+/// and lowest covered cell); the spheres live in one dense array by slot, so an
+/// update that keeps the covered cells writes one sphere and touches no cell.
 /// The z coordinate is not gridded: the exact shared overlap tests decide.
+/// Queries prune cells by a loose box: the cell grown by twice the largest radius
+/// stored, within the bounds of everything stored (both only grow until `clear`
+/// or the grid empties; see the docs of `Reach` in the source).
 ///
 /// **Outside the rectangle.** Coordinates are clamped, so objects (and queries)
 /// beyond the rectangle are referenced from the border cells. Answers stay exact;
@@ -56,20 +60,24 @@ struct Item<T> {
 /// (see `ray.rs`). No allocation, no shared state: queries may run in parallel.
 ///
 /// Costs, with `k` references per cell: insert/remove O(cells covered × k);
-/// update O(cells covered × k), and only the stored sphere copies change while the
-/// covered cells stay the same; range queries O(cells covered + references in
+/// update O(1) while the covered cells stay the same, else O(cells covered × k);
+/// range queries O(cells covered + references in
 /// them); rays O(cells along the ray's XY projection); frustums O(all cells);
-/// pairs O(Σ k²). Memory: 48 bytes per cell plus 24 per reference. Objects much
+/// pairs O(Σ k²). Memory: 24 bytes per cell, 8 per reference, 16 per object for the sphere. Objects much
 /// larger than a cell are referenced from many cells: the grid suits similar sizes.
 #[derive(Clone, Debug)]
 pub struct UniformGrid2d<T> {
     geom: Geometry,
     cells: Vec<CellList<[u16; 2]>>,
     items: Arena<Item<T>>,
+    /// Slot → sphere of the live object there (hot data for pairs and queries).
+    spheres: Vec<Sphere>,
     /// Slot → live handle, to report a handle from a reference.
     handles: Vec<Handle>,
     /// Total number of references (for validation).
     refs: usize,
+    /// Growing bounds on the stored spheres, for the cells' loose boxes.
+    reach: Reach,
 }
 
 impl<T> UniformGrid2d<T> {
@@ -95,8 +103,10 @@ impl<T> UniformGrid2d<T> {
             cells: vec![CellList::default(); geom.cell_count()],
             geom,
             items: Arena::new(),
+            spheres: Vec::new(),
             handles: Vec::new(),
             refs: 0,
+            reach: Reach::default(),
         })
     }
 
@@ -132,16 +142,31 @@ impl<T> UniformGrid2d<T> {
         self.refs
     }
 
-    /// The handle and item of a referenced slot. References always name live slots
-    /// (checked by `validate`), so failure is a bug.
+    /// The handle and payload of a referenced slot. References always name live
+    /// slots (checked by `validate`), so failure is a bug.
     #[inline]
-    fn resolve(&self, slot: u32) -> (Handle, &Item<T>) {
+    fn resolve(&self, slot: u32) -> (Handle, &T) {
         let h = self.handles[slot as usize];
         let item = self
             .items
             .get(h)
             .expect("grid reference to a dead slot: invariant broken");
-        (h, item)
+        (h, &item.value)
+    }
+
+    /// The loose box of cell `(x, y)`: a box containing every sphere it references.
+    #[inline]
+    fn loose(&self, x: u32, y: u32) -> Aabb {
+        let g = &self.geom;
+        let min = glam::vec3(
+            g.origin[0] + x as f32 * g.cell,
+            g.origin[1] + y as f32 * g.cell,
+            0.0,
+        );
+        let max = min + glam::vec3(g.cell, g.cell, 0.0);
+        let open_lo = glam::BVec3::new(x == 0, y == 0, true);
+        let open_hi = glam::BVec3::new(x == g.dims[0] - 1, y == g.dims[1] - 1, true);
+        g.padded(&self.reach.loose(min, max, open_lo, open_hi))
     }
 }
 
@@ -149,23 +174,25 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid2d<T> {
     fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         sphere.validate()?;
         let rect = self.geom.sphere_rect(&sphere);
-        let h = self.items.insert(Item {
-            sphere,
-            rect,
-            value,
-        });
+        let h = self.items.insert(Item { rect, value });
         let slot = h.index() as usize;
         if self.handles.len() <= slot {
             self.handles.resize(slot + 1, h);
+            self.spheres.resize(slot + 1, sphere);
         }
         self.handles[slot] = h;
-        self.link(h.index(), &sphere, rect);
+        self.spheres[slot] = sphere;
+        self.reach.include(&sphere);
+        self.link(h.index(), rect);
         Ok(h)
     }
 
     fn remove(&mut self, handle: Handle) -> Result<T> {
         let item = self.items.remove(handle)?;
         self.unlink(handle.index(), item.rect);
+        if self.items.is_empty() {
+            self.reach = Reach::default();
+        }
         Ok(item.value)
     }
 
@@ -174,14 +201,18 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid2d<T> {
         let item = self.items.get_mut(handle)?;
         let old = item.rect;
         let new = self.geom.sphere_rect(&sphere);
-        item.sphere = sphere;
         item.rect = new;
-        self.relink(handle.index(), &sphere, old, new);
+        self.spheres[handle.index() as usize] = sphere;
+        self.reach.include(&sphere);
+        if old != new {
+            self.relink(handle.index(), old, new);
+        }
         Ok(())
     }
 
     fn get(&self, handle: Handle) -> Result<(Sphere, &T)> {
-        self.items.get(handle).map(|i| (i.sphere, &i.value))
+        let item = self.items.get(handle)?;
+        Ok((self.spheres[handle.index() as usize], &item.value))
     }
 
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
@@ -195,15 +226,17 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid2d<T> {
     fn clear(&mut self) {
         self.items.clear();
         self.handles = Vec::new();
+        self.spheres = Vec::new();
         for c in &mut self.cells {
             *c = CellList::default();
         }
         self.refs = 0;
+        self.reach = Reach::default();
     }
 
     fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
         for (h, i) in self.items.iter() {
-            f(h, &i.sphere, &i.value);
+            f(h, &self.spheres[h.index() as usize], &i.value);
         }
     }
 
@@ -241,6 +274,7 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid2d<T> {
         std::mem::size_of::<Self>()
             + self.items.heap_bytes()
             + self.handles.capacity() * std::mem::size_of::<Handle>()
+            + self.spheres.capacity() * std::mem::size_of::<Sphere>()
             + self.cells.capacity() * std::mem::size_of::<CellList<[u16; 2]>>()
             + self.cells.iter().map(|c| c.heap_bytes()).sum::<usize>()
     }
@@ -270,7 +304,7 @@ mod tests {
     }
 
     #[test]
-    fn update_within_the_same_cells_only_changes_the_copy() {
+    fn update_within_the_same_cells_touches_no_cell() {
         let w = Aabb::new(Vec3::ZERO, vec3(100.0, 100.0, 1.0));
         let mut g = UniformGrid2d::with_cell_size(w, 10.0).unwrap();
         let h = g

@@ -13,7 +13,7 @@ impl<T> UniformGrid2d<T> {
     /// the lowest one both cover, `(max(ax0, bx0), max(ay0, by0))` — read from the
     /// lowest cells stored in the references, so the check costs two comparisons
     /// and runs only after the sphere test succeeded. Cost O(Σ k²) sphere tests
-    /// over cells with `k` references, on contiguous memory.
+    /// over cells with `k` references.
     pub(super) fn visit_pairs(
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
@@ -26,14 +26,15 @@ impl<T> UniformGrid2d<T> {
             }
             let (x, y) = ((ci % nx) as u16, (ci / nx) as u16);
             for (i, ea) in es.iter().enumerate() {
+                let sa = &self.spheres[ea.slot as usize];
                 for eb in &es[i + 1..] {
-                    if overlap::sphere_sphere(&ea.sphere, &eb.sphere)
+                    if overlap::sphere_sphere(sa, &self.spheres[eb.slot as usize])
                         && ea.lo[0].max(eb.lo[0]) == x
                         && ea.lo[1].max(eb.lo[1]) == y
                     {
-                        let (ha, ia) = self.resolve(ea.slot);
-                        let (hb, ib) = self.resolve(eb.slot);
-                        f(ha, &ia.value, hb, &ib.value)?;
+                        let (ha, va) = self.resolve(ea.slot);
+                        let (hb, vb) = self.resolve(eb.slot);
+                        f(ha, va, hb, vb)?;
                     }
                 }
             }

@@ -18,7 +18,7 @@ impl<T> UniformGrid2d<T> {
     /// the scan reaches it exactly once. The test is two comparisons against the
     /// lowest cell stored in the reference, before any geometry.
     ///
-    /// Each non-empty cell is first classified against its padded loose box:
+    /// Each non-empty cell is first classified against its loose box:
     /// `Outside` skips the cell, `Inside` reports its objects without the exact
     /// test (the selection contract makes both sound).
     pub(super) fn visit_rect<Q: Selection + ?Sized>(
@@ -33,7 +33,7 @@ impl<T> UniformGrid2d<T> {
                 if cell.entries.is_empty() {
                     continue;
                 }
-                let (rel, _) = q.classify_box(&self.geom.padded(&cell.loose), Frustum::ALL_PLANES);
+                let (rel, _) = q.classify_box(&self.loose(x, y), Frustum::ALL_PLANES);
                 if rel == Relation::Outside {
                     continue;
                 }
@@ -41,9 +41,10 @@ impl<T> UniformGrid2d<T> {
                     if (e.lo[0] as u32).max(rect.x0) != x || (e.lo[1] as u32).max(rect.y0) != y {
                         continue;
                     }
-                    if rel == Relation::Inside || q.selects(&e.sphere) {
-                        let (h, item) = self.resolve(e.slot);
-                        f(h, &e.sphere, &item.value)?;
+                    let s = &self.spheres[e.slot as usize];
+                    if rel == Relation::Inside || q.selects(s) {
+                        let (h, v) = self.resolve(e.slot);
+                        f(h, s, v)?;
                     }
                 }
             }

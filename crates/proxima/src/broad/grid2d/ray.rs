@@ -12,7 +12,7 @@
 //! the strips in which a given object (a cell rectangle) appears are consecutive.
 //! An object is reported in the first of them — the one whose predecessor does not
 //! contain it — and there only from the row `max(r0, ob0)`. Both checks use the
-//! object's cell range recomputed from the sphere copy, with no allocation.
+//! object's cell range recomputed from its sphere, with no allocation.
 //!
 //! A ray with zero XY direction (vertical) stays in one column of cells: it is a
 //! rectangle query over the cells of its (padded) XY point.
@@ -49,7 +49,8 @@ impl<T> UniformGrid2d<T> {
         // The slab test's rounding grows with the origin's magnitude: pad the loose
         // boxes by as much so the box test never rejects a sphere the exact test hits.
         let extra = o.abs().max_element() * RAY_PAD;
-        let touches = |b: &Aabb| overlap::ray_aabb(ray, &g.padded(b).grown(extra)).is_some();
+        let touches =
+            |x: u32, y: u32| overlap::ray_aabb(ray, &self.loose(x, y).grown(extra)).is_some();
         let (a, b) = if d.x.abs() >= d.y.abs() {
             (0, 1)
         } else {
@@ -61,7 +62,7 @@ impl<T> UniformGrid2d<T> {
             for y in rect.y0..=rect.y1 {
                 for x in rect.x0..=rect.x1 {
                     let cell = &self.cells[g.index(x, y)];
-                    if cell.entries.is_empty() || !touches(&cell.loose) {
+                    if cell.entries.is_empty() || !touches(x, y) {
                         continue;
                     }
                     for e in &cell.entries {
@@ -115,11 +116,11 @@ impl<T> UniformGrid2d<T> {
             for r in r0..=r1 {
                 let (x, y) = if a == 0 { (i, r) } else { (r, i) };
                 let cell = &self.cells[g.index(x, y)];
-                if cell.entries.is_empty() || !touches(&cell.loose) {
+                if cell.entries.is_empty() || !touches(x, y) {
                     continue;
                 }
                 for e in &cell.entries {
-                    let or = g.sphere_rect(&e.sphere);
+                    let or = g.sphere_rect(&self.spheres[e.slot as usize]);
                     let (oa0, oa1, ob0, ob1) = if a == 0 {
                         (or.x0, or.x1, or.y0, or.y1)
                     } else {
@@ -158,9 +159,10 @@ impl<T> UniformGrid2d<T> {
     ) -> ControlFlow<()> {
         self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
-                if overlap::ray_sphere(ray, &e.sphere).is_some() {
-                    let (h, item) = self.resolve(e.slot);
-                    f(h, &e.sphere, &item.value)
+                let s = &self.spheres[e.slot as usize];
+                if overlap::ray_sphere(ray, s).is_some() {
+                    let (h, v) = self.resolve(e.slot);
+                    f(h, s, v)
                 } else {
                     ControlFlow::Continue(())
                 }
@@ -175,7 +177,7 @@ impl<T> UniformGrid2d<T> {
         let mut best: Option<RayHit> = None;
         let _ = self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
-                if let Some(t) = overlap::ray_sphere(ray, &e.sphere) {
+                if let Some(t) = overlap::ray_sphere(ray, &self.spheres[e.slot as usize]) {
                     let h = self.handles[e.slot as usize];
                     let better = match best {
                         None => true,

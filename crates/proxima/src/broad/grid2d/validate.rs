@@ -12,10 +12,11 @@ impl<T> UniformGrid2d<T> {
     /// - the arena, and the slot → handle table for every live object;
     /// - every object's stored cell range is the one its sphere gives;
     /// - every reference names a live object, sits in a cell of that object's
-    ///   range, carries its exact sphere and lowest cell, and no cell references an
-    ///   object twice; with the count check below, every object is referenced from
-    ///   exactly the cells of its range;
-    /// - the reference count, and each cell's loose box contains its spheres.
+    ///   range, carries its lowest cell, and no cell references an object twice;
+    ///   with the count check below, every object is referenced from exactly the
+    ///   cells of its range;
+    /// - the reference count, and the growing bounds cover every sphere (so every
+    ///   cell's loose box contains the spheres it references).
     pub(super) fn check(&self) -> Result<()> {
         self.items.validate()?;
         if self.cells.len() != self.geom.cell_count() {
@@ -33,7 +34,16 @@ impl<T> UniformGrid2d<T> {
                     h.index()
                 ));
             }
-            let rect = self.geom.sphere_rect(&item.sphere);
+            let Some(sphere) = self.spheres.get(h.index() as usize) else {
+                return fail(format!("no sphere for slot {}", h.index()));
+            };
+            if !self.reach.covers(sphere) {
+                return fail(format!(
+                    "bounds do not cover the sphere of slot {}",
+                    h.index()
+                ));
+            }
+            let rect = self.geom.sphere_rect(sphere);
             if rect != item.rect {
                 return fail(format!("stale cell range {:?} for {:?}", item.rect, h));
             }
@@ -67,18 +77,15 @@ impl<T> UniformGrid2d<T> {
                         e.slot
                     ));
                 }
-                if e.sphere != item.sphere || e.lo != item.rect.lo() {
+                if e.lo != item.rect.lo() {
                     return fail(format!(
-                        "cell ({x}, {y}) has a stale copy of slot {}",
+                        "cell ({x}, {y}) has a stale lowest cell for slot {}",
                         e.slot
                     ));
                 }
                 if std::mem::replace(&mut last_cell[e.slot as usize], ci) == ci {
                     return fail(format!("cell ({x}, {y}) references slot {} twice", e.slot));
                 }
-            }
-            if !cell.loose_is_valid() {
-                return fail(format!("cell ({x}, {y}) loose box misses a sphere"));
             }
             total += cell.entries.len();
         }

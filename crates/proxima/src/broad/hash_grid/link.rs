@@ -3,7 +3,6 @@
 use super::keys::{Key, KeyBox};
 use super::{Cell, HashGrid, Place};
 use crate::broad::cell_list::CellList;
-use crate::geom::Sphere;
 
 impl<T> HashGrid<T> {
     /// The cell slot of `key`, created (reusing a freed slot) if absent.
@@ -62,8 +61,8 @@ impl<T> HashGrid<T> {
     }
 
     /// References `slot` from every cell of `kb`.
-    pub(super) fn link(&mut self, slot: u32, sphere: &Sphere, kb: KeyBox) {
-        kb.for_each(|k| self.cell_mut(k).push(*sphere, slot, kb.lo));
+    pub(super) fn link(&mut self, slot: u32, kb: KeyBox) {
+        kb.for_each(|k| self.cell_mut(k).push(slot, kb.lo));
         self.refs += kb.volume() as usize;
     }
 
@@ -76,24 +75,23 @@ impl<T> HashGrid<T> {
         self.refs -= kb.volume() as usize;
     }
 
-    /// Moves `slot` from the cells of `old` to those of `new`; when they are the
-    /// same only the sphere copies change.
-    pub(super) fn relink(&mut self, slot: u32, sphere: &Sphere, old: KeyBox, new: KeyBox) {
+    /// Moves `slot` from the cells of `old` to those of a different `new`: drops
+    /// the references that leave, adds those that arrive, updates the lowest cell
+    /// stored in those that stay.
+    pub(super) fn relink(&mut self, slot: u32, old: KeyBox, new: KeyBox) {
         old.for_each(|k| {
             let found = if new.contains(k) {
-                self.cell_mut(k).overwrite(slot, *sphere, new.lo)
+                self.cell_mut(k).set_lo(slot, new.lo)
             } else {
                 self.remove_ref(k, slot)
             };
             debug_assert!(found, "missing hash grid reference");
         });
-        if old != new {
-            new.for_each(|k| {
-                if !old.contains(k) {
-                    self.cell_mut(k).push(*sphere, slot, new.lo);
-                }
-            });
-        }
+        new.for_each(|k| {
+            if !old.contains(k) {
+                self.cell_mut(k).push(slot, new.lo);
+            }
+        });
         self.refs = self.refs - old.volume() as usize + new.volume() as usize;
     }
 

@@ -14,9 +14,9 @@ mod ray;
 mod validate;
 
 use crate::arena::{Arena, Handle};
-use crate::broad::cell_list::CellList;
+use crate::broad::cell_list::{CellList, Reach};
 use crate::broad::{RayHit, Selection, SpatialIndex};
-use crate::geom::{Ray, Sphere};
+use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Result};
 use keys::{Key, KeyBox, Keys};
 use rustc_hash::FxHashMap;
@@ -35,9 +35,10 @@ enum Place {
     Oversized(u32),
 }
 
+/// A stored object: where it is referenced from and its payload (the sphere is
+/// in the dense `spheres` array).
 #[derive(Clone, Debug)]
 struct Item<T> {
-    sphere: Sphere,
     place: Place,
     value: T,
 }
@@ -51,9 +52,10 @@ struct Cell {
 
 /// A hashed uniform grid over all of 3D space (no world box needed).
 ///
-/// Every object is referenced from each cell its bounding box covers; each
-/// reference keeps a copy of the sphere so pairs and range queries scan contiguous
-/// memory. Cells live in a flat `Vec` with a free list and are found through an
+/// Every object is referenced from each cell its bounding box covers, by a
+/// 16-byte reference (slot and lowest covered cell); the spheres live in one dense
+/// array by slot, so an update that keeps the covered cells writes one sphere and
+/// touches no cell or hash entry. Cells live in a flat `Vec` with a free list and are found through an
 /// [`FxHashMap`] from integer coordinates (the fast non-cryptographic hasher of
 /// `rustc-hash`).
 ///
@@ -79,11 +81,13 @@ struct Cell {
 /// the lowest cell of the overlap of its key box with the query's, and a pair only
 /// from the lowest cell both cover.
 ///
-/// Costs, with `k` references per cell: insert/remove/update O(cells covered × k)
-/// (only the sphere copies change when the covered cells stay the same), range
+/// Costs, with `k` references per cell: insert/remove O(cells covered × k), update
+/// O(1) while the covered cells stay the same and O(cells covered × k) otherwise, range
 /// queries O(min(cells in range, occupied cells) + references met), pairs
-/// O(Σ k² + oversized × query). Memory: about 90 bytes per occupied cell plus 32
-/// per reference.
+/// O(Σ k² + oversized × query). Memory: about 60 bytes per occupied cell, 16
+/// per reference, 16 per object for the sphere. Queries prune cells by a loose
+/// box: the cell grown by twice the largest gridded radius, within the bounds of
+/// everything stored (both only grow until `clear` or the grid empties).
 #[derive(Clone, Debug)]
 pub struct HashGrid<T> {
     keys: Keys,
@@ -91,8 +95,12 @@ pub struct HashGrid<T> {
     cells: Vec<Cell>,
     free_cells: Vec<u32>,
     items: Arena<Item<T>>,
+    /// Slot → sphere of the live object there (hot data for pairs and queries).
+    spheres: Vec<Sphere>,
     /// Slot → live handle, to report a handle from a reference.
     handles: Vec<Handle>,
+    /// Growing bounds on the gridded spheres, for the cells' loose boxes.
+    reach: Reach,
     /// Slots of the oversized objects.
     oversized: Vec<u32>,
     /// Total number of references.
@@ -130,7 +138,9 @@ impl<T> HashGrid<T> {
             cells: Vec::new(),
             free_cells: Vec::new(),
             items: Arena::new(),
+            spheres: Vec::new(),
             handles: Vec::new(),
+            reach: Reach::default(),
             oversized: Vec::new(),
             refs: 0,
             occupied: KeyBox::EMPTY,
@@ -164,16 +174,28 @@ impl<T> HashGrid<T> {
         (kb.volume() <= MAX_CELLS_PER_OBJECT).then_some(kb)
     }
 
-    /// The handle and item of a referenced slot (references name live slots:
+    /// The handle and payload of a referenced slot (references name live slots:
     /// checked by `validate`, so failure is a bug).
     #[inline]
-    fn resolve(&self, slot: u32) -> (Handle, &Item<T>) {
+    fn resolve(&self, slot: u32) -> (Handle, &T) {
         let h = self.handles[slot as usize];
         let item = self
             .items
             .get(h)
             .expect("hash grid reference to a dead slot: invariant broken");
-        (h, item)
+        (h, &item.value)
+    }
+
+    /// The loose box of cell `key`: a box containing every sphere it references.
+    #[inline]
+    fn loose(&self, key: Key) -> Aabb {
+        let min = glam::IVec3::from(key).as_vec3() * self.keys.cell;
+        let max = min + glam::Vec3::splat(self.keys.cell);
+        let k = glam::IVec3::from(key);
+        let open_lo = k.cmple(glam::IVec3::splat(-keys::LIMIT));
+        let open_hi = k.cmpge(glam::IVec3::splat(keys::LIMIT));
+        self.keys
+            .padded(&self.reach.loose(min, max, open_lo, open_hi))
     }
 }
 
@@ -185,7 +207,8 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
         let slot = h.index();
         let place = match cells {
             Some(kb) => {
-                self.link(slot, &sphere, kb);
+                self.reach.include(&sphere);
+                self.link(slot, kb);
                 Place::Cells(kb)
             }
             None => {
@@ -193,16 +216,14 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
                 Place::Oversized(self.oversized.len() as u32 - 1)
             }
         };
-        let h2 = self.items.insert(Item {
-            sphere,
-            place,
-            value,
-        });
+        let h2 = self.items.insert(Item { place, value });
         debug_assert_eq!(h, h2);
         if self.handles.len() <= slot as usize {
             self.handles.resize(slot as usize + 1, h);
+            self.spheres.resize(slot as usize + 1, sphere);
         }
         self.handles[slot as usize] = h;
+        self.spheres[slot as usize] = sphere;
         Ok(h)
     }
 
@@ -212,6 +233,9 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
             Place::Cells(kb) => self.unlink(handle.index(), kb),
             Place::Oversized(i) => self.drop_oversized(i),
         }
+        if self.items.is_empty() {
+            self.reach = Reach::default();
+        }
         Ok(item.value)
     }
 
@@ -219,9 +243,15 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
         sphere.validate()?;
         let old = self.items.get(handle)?.place;
         let slot = handle.index();
-        let place = match (old, self.cells_of(&sphere)) {
+        let cells = self.cells_of(&sphere);
+        if cells.is_some() {
+            self.reach.include(&sphere);
+        }
+        let place = match (old, cells) {
             (Place::Cells(a), Some(b)) => {
-                self.relink(slot, &sphere, a, b);
+                if a != b {
+                    self.relink(slot, a, b);
+                }
                 Place::Cells(b)
             }
             (Place::Cells(a), None) => {
@@ -231,20 +261,20 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
             }
             (Place::Oversized(i), Some(b)) => {
                 self.drop_oversized(i);
-                self.link(slot, &sphere, b);
+                self.link(slot, b);
                 Place::Cells(b)
             }
             (Place::Oversized(_), None) => old,
         };
         // `drop_oversized` may have moved another object, never this one's item.
-        let item = self.items.get_mut(handle)?;
-        item.sphere = sphere;
-        item.place = place;
+        self.items.get_mut(handle)?.place = place;
+        self.spheres[slot as usize] = sphere;
         Ok(())
     }
 
     fn get(&self, handle: Handle) -> Result<(Sphere, &T)> {
-        self.items.get(handle).map(|i| (i.sphere, &i.value))
+        let item = self.items.get(handle)?;
+        Ok((self.spheres[handle.index() as usize], &item.value))
     }
 
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
@@ -263,7 +293,9 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
             cells: Vec::new(),
             free_cells: Vec::new(),
             items: Arena::new(),
+            spheres: Vec::new(),
             handles: Vec::new(),
+            reach: Reach::default(),
             oversized: Vec::new(),
             refs: 0,
             occupied: KeyBox::EMPTY,
@@ -273,7 +305,7 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
 
     fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
         for (h, i) in self.items.iter() {
-            f(h, &i.sphere, &i.value);
+            f(h, &self.spheres[h.index() as usize], &i.value);
         }
     }
 
@@ -292,9 +324,10 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
             self.visit_cells(query, kb, &mut f)?;
         }
         for &slot in &self.oversized {
-            let (h, item) = self.resolve(slot);
-            if query.selects(&item.sphere) {
-                f(h, &item.sphere, &item.value)?;
+            let s = &self.spheres[slot as usize];
+            if query.selects(s) {
+                let (h, v) = self.resolve(slot);
+                f(h, s, v)?;
             }
         }
         ControlFlow::Continue(())
@@ -330,6 +363,7 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
             + self.free_cells.capacity() * 4
             + self.items.heap_bytes()
             + self.handles.capacity() * std::mem::size_of::<Handle>()
+            + self.spheres.capacity() * std::mem::size_of::<Sphere>()
             + self.oversized.capacity() * 4
     }
 }

@@ -26,29 +26,31 @@ impl<T> HashGrid<T> {
             }
             let key = cell.key;
             for (i, ea) in es.iter().enumerate() {
+                let sa = &self.spheres[ea.slot as usize];
                 for eb in &es[i + 1..] {
-                    if overlap::sphere_sphere(&ea.sphere, &eb.sphere)
+                    if overlap::sphere_sphere(sa, &self.spheres[eb.slot as usize])
                         && ea.lo[0].max(eb.lo[0]) == key[0]
                         && ea.lo[1].max(eb.lo[1]) == key[1]
                         && ea.lo[2].max(eb.lo[2]) == key[2]
                     {
-                        let (ha, ia) = self.resolve(ea.slot);
-                        let (hb, ib) = self.resolve(eb.slot);
-                        f(ha, &ia.value, hb, &ib.value)?;
+                        let (ha, va) = self.resolve(ea.slot);
+                        let (hb, vb) = self.resolve(eb.slot);
+                        f(ha, va, hb, vb)?;
                     }
                 }
             }
         }
-        for (i, &sa) in self.oversized.iter().enumerate() {
-            let (ha, ia) = self.resolve(sa);
-            for &sb in &self.oversized[i + 1..] {
-                let (hb, ib) = self.resolve(sb);
-                if overlap::sphere_sphere(&ia.sphere, &ib.sphere) {
-                    f(ha, &ia.value, hb, &ib.value)?;
+        for (i, &a) in self.oversized.iter().enumerate() {
+            let (ha, va) = self.resolve(a);
+            let sa = &self.spheres[a as usize];
+            for &b in &self.oversized[i + 1..] {
+                if overlap::sphere_sphere(sa, &self.spheres[b as usize]) {
+                    let (hb, vb) = self.resolve(b);
+                    f(ha, va, hb, vb)?;
                 }
             }
-            let kb: KeyBox = self.keys.sphere_box(&ia.sphere);
-            self.visit_cells(&ia.sphere, kb, &mut |hb, _, vb| f(ha, &ia.value, hb, vb))?;
+            let kb: KeyBox = self.keys.sphere_box(sa);
+            self.visit_cells(sa, kb, &mut |hb, _, vb| f(ha, va, hb, vb))?;
         }
         ControlFlow::Continue(())
     }

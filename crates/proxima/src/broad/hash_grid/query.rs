@@ -51,7 +51,7 @@ impl<T> HashGrid<T> {
         }
     }
 
-    /// One cell of a query: prune by the padded loose box, then report the
+    /// One cell of a query: prune by the loose box, then report the
     /// references whose lowest shared cell with `kb` is this one.
     #[inline]
     fn scan_cell<Q: Selection + ?Sized>(
@@ -62,7 +62,7 @@ impl<T> HashGrid<T> {
         list: &CellList<Key>,
         f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let (rel, _) = q.classify_box(&self.keys.padded(&list.loose), Frustum::ALL_PLANES);
+        let (rel, _) = q.classify_box(&self.loose(key), Frustum::ALL_PLANES);
         if rel == Relation::Outside {
             return ControlFlow::Continue(());
         }
@@ -70,9 +70,10 @@ impl<T> HashGrid<T> {
             if (0..3).any(|a| e.lo[a].max(kb.lo[a]) != key[a]) {
                 continue;
             }
-            if rel == Relation::Inside || q.selects(&e.sphere) {
-                let (h, item) = self.resolve(e.slot);
-                f(h, &e.sphere, &item.value)?;
+            let s = &self.spheres[e.slot as usize];
+            if rel == Relation::Inside || q.selects(s) {
+                let (h, v) = self.resolve(e.slot);
+                f(h, s, v)?;
             }
         }
         ControlFlow::Continue(())

@@ -18,7 +18,7 @@ use super::HashGrid;
 use crate::arena::Handle;
 use crate::broad::cell_list::CellEntry;
 use crate::broad::RayHit;
-use crate::geom::{overlap, Aabb, Ray, Sphere};
+use crate::geom::{overlap, Ray, Sphere};
 use std::ops::ControlFlow;
 
 /// Relative padding of the ray's coordinates (rounding of `o + d t`).
@@ -66,7 +66,8 @@ impl<T> HashGrid<T> {
         let k = &self.keys;
         let (o, d) = (ray.origin, ray.dir);
         let extra = o.abs().max_element() * RAY_PAD;
-        let touches = |b: &Aabb| overlap::ray_aabb(ray, &k.padded(b).grown(extra)).is_some();
+        let touches =
+            |key: [i32; 3]| overlap::ray_aabb(ray, &self.loose(key).grown(extra)).is_some();
         let ad = d.abs();
         let a = if ad.x >= ad.y && ad.x >= ad.z {
             0
@@ -118,7 +119,7 @@ impl<T> HashGrid<T> {
         }) else {
             // Scan: each object from its own lowest cell.
             for cell in &self.cells {
-                if cell.list.entries.is_empty() || !touches(&cell.list.loose) {
+                if cell.list.entries.is_empty() || !touches(cell.key) {
                     continue;
                 }
                 for e in &cell.list.entries {
@@ -183,11 +184,11 @@ impl<T> HashGrid<T> {
                         continue;
                     };
                     let list = &self.cells[slot as usize].list;
-                    if !touches(&list.loose) {
+                    if !touches(key) {
                         continue;
                     }
                     for e in &list.entries {
-                        let ob: KeyBox = k.sphere_box(&e.sphere);
+                        let ob: KeyBox = k.sphere_box(&self.spheres[e.slot as usize]);
                         if rb != b0.max(ob.lo[b]) || rc != c0.max(ob.lo[c]) {
                             continue;
                         }
@@ -228,9 +229,10 @@ impl<T> HashGrid<T> {
     ) -> ControlFlow<()> {
         self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
-                if overlap::ray_sphere(ray, &e.sphere).is_some() {
-                    let (h, item) = self.resolve(e.slot);
-                    f(h, &e.sphere, &item.value)
+                let s = &self.spheres[e.slot as usize];
+                if overlap::ray_sphere(ray, s).is_some() {
+                    let (h, v) = self.resolve(e.slot);
+                    f(h, s, v)
                 } else {
                     ControlFlow::Continue(())
                 }
@@ -244,14 +246,13 @@ impl<T> HashGrid<T> {
     pub(super) fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
         for &slot in &self.oversized {
-            let (h, item) = self.resolve(slot);
-            if let Some(t) = overlap::ray_sphere(ray, &item.sphere) {
-                offer(&mut best, t, h);
+            if let Some(t) = overlap::ray_sphere(ray, &self.spheres[slot as usize]) {
+                offer(&mut best, t, self.handles[slot as usize]);
             }
         }
         let _ = self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
-                if let Some(t) = overlap::ray_sphere(ray, &e.sphere) {
+                if let Some(t) = overlap::ray_sphere(ray, &self.spheres[e.slot as usize]) {
                     offer(&mut best, t, self.handles[e.slot as usize]);
                 }
                 ControlFlow::Continue(())

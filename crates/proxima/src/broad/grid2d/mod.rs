@@ -23,7 +23,7 @@ use cells::{CellRect, Geometry};
 use std::ops::ControlFlow;
 
 /// Default cap on the number of cells chosen by [`UniformGrid2d::new`].
-pub const DEFAULT_MAX_CELLS: usize = 1 << 20;
+const DEFAULT_MAX_CELLS: usize = 1 << 20;
 
 /// A stored object: the cells it is referenced from and its payload (the sphere
 /// is in the dense `spheres` array).
@@ -112,8 +112,8 @@ impl<T> UniformGrid2d<T> {
 
     /// The default cell edge: twice `typical_radius` (a typical footprint then
     /// covers at most 2 × 2 cells, so each object has few references while each cell
-    /// holds few objects), enlarged if the rectangle would need more than
-    /// [`DEFAULT_MAX_CELLS`] cells. A zero radius gives 1/256 of the longer side.
+    /// holds few objects), enlarged if the rectangle would need more than 2^20
+    /// cells. A zero radius gives 1/256 of the longer side.
     pub fn default_cell_size(world: &Aabb, typical_radius: f32) -> f32 {
         let e = world.extent();
         let side = e.x.max(e.y);

@@ -24,7 +24,7 @@ use std::ops::ControlFlow;
 
 /// Objects whose bounding box covers more cells than this are kept in the
 /// oversized list instead of the cells.
-pub const MAX_CELLS_PER_OBJECT: u64 = 64;
+const MAX_CELLS_PER_OBJECT: u64 = 64;
 
 /// Where an object is referenced from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -64,9 +64,9 @@ struct Cell {
 /// Smaller cells multiply references and update cost; larger cells put more
 /// objects in each cell and pair tests grow with their square.
 ///
-/// **Oversized objects.** An object covering more than [`MAX_CELLS_PER_OBJECT`]
-/// cells is not gridded: it goes to a list that every query tests directly, and
-/// pairs involving it are found by querying the grid with its sphere. This keeps
+/// **Oversized objects.** An object whose bounding box covers more than 64 cells
+/// is not gridded: it goes to a list that every query tests directly, and pairs
+/// involving it are found by querying the grid with its sphere. This keeps
 /// memory bounded for huge spheres at the price of O(oversized) per query.
 ///
 /// **Unbounded queries.** A query's key box is clipped to the box of occupied

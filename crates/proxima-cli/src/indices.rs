@@ -6,7 +6,8 @@
 //! entry in the `registry!` invocation at the bottom of this file.
 
 use proxima::broad::{
-    BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex, UniformGrid2d,
+    loose_kd, BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex,
+    UniformGrid2d,
 };
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::Vec3;
@@ -110,7 +111,7 @@ pub const BRUTE: &str = "brute";
 
 registry! {
     "brute" => |_| Ok(BruteForce::<u64>::new()),
-    "loose-kd" => |h| LooseKdTree::<u64>::new(h.world, h.r_max, 0.25),
+    "loose-kd" => |h| LooseKdTree::<u64>::new(h.world, h.r_max, loose_kd::DEFAULT_DENSITY),
     "octree" => |h| LinearOctree::<u64>::new(h.world, OctreeConfig::default()),
     "grid2d" => |h| UniformGrid2d::<u64>::new(h.world, h.r_max),
     "hashgrid" => |h| HashGrid::<u64>::new(h.r_max),

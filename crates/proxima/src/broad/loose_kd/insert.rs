@@ -1,8 +1,8 @@
 //! Insertion (seed `RecursivePush`, iterative): the placement rule, lazy node
-//! creation, and the O(1) intrusive item list of each node.
+//! creation, and the O(1) placement and swap-removal of objects in a node.
 
-use super::node::{all_space, Node, NIL};
-use super::LooseKdTree;
+use super::node::{all_space, Node, Slot, NIL};
+use super::{Loc, LooseKdTree};
 use crate::geom::Sphere;
 
 impl<T> LooseKdTree<T> {
@@ -17,6 +17,7 @@ impl<T> LooseKdTree<T> {
                 0,
                 self.r_max,
                 self.density,
+                self.spare.pop().unwrap_or_default(),
             );
             self.root = self.nodes.alloc(n);
         }
@@ -40,6 +41,7 @@ impl<T> LooseKdTree<T> {
     }
 
     fn new_child(&mut self, parent: u32, side: usize) -> u32 {
+        let slots = self.spare.pop().unwrap_or_default();
         let p = &self.nodes[parent];
         let (bbox, cell) = p.child_bounds(side);
         let node = Node::new(
@@ -50,52 +52,39 @@ impl<T> LooseKdTree<T> {
             p.depth + 1,
             self.r_max,
             self.density,
+            slots,
         );
         let c = self.nodes.alloc(node);
         self.nodes[parent].child[side] = c;
         c
     }
 
-    /// Pushes item slot `idx` at the front of `node`'s list. O(1).
-    pub(super) fn link(&mut self, node: u32, idx: u32) {
-        let head = self.nodes[node].first;
-        {
-            let it = self
-                .items
-                .get_by_index_mut(idx)
-                .expect("linking a live item");
-            it.node = node;
-            it.prev = NIL;
-            it.next = head;
-        }
-        if head != NIL {
-            self.items.get_by_index_mut(head).expect("list head").prev = idx;
-        }
-        let n = &mut self.nodes[node];
-        n.first = idx;
-        n.count += 1;
+    /// Appends `slot` to `node`'s objects and records its location. O(1)
+    /// amortized (no allocation once the node's vector has grown).
+    pub(super) fn put_slot(&mut self, node: u32, slot: Slot<T>) {
+        let slots = &mut self.nodes[node].slots;
+        let pos = slots.len() as u32;
+        let idx = slot.handle.index();
+        slots.push(slot);
+        *self
+            .items
+            .get_by_index_mut(idx)
+            .expect("placing a live item") = Loc { node, pos };
     }
 
-    /// Takes item slot `idx` out of its node's list (seed `DeleteItem`) and returns
-    /// that node. O(1). The item keeps its stale `node` until relinked.
-    pub(super) fn unlink(&mut self, idx: u32) -> u32 {
-        let (node, prev, next) = {
-            let it = self
-                .items
-                .get_by_index(idx)
-                .expect("unlinking a live item")
-                .1;
-            (it.node, it.prev, it.next)
-        };
-        if prev != NIL {
-            self.items.get_by_index_mut(prev).expect("prev").next = next;
-        } else {
-            self.nodes[node].first = next;
+    /// Takes the object at `loc` out of its node (seed `DeleteItem`) by moving the
+    /// node's last object into the hole, whose location is updated. O(1). The
+    /// taken object's own location is stale until it is placed again.
+    pub(super) fn take_slot(&mut self, loc: Loc) -> Slot<T> {
+        let slots = &mut self.nodes[loc.node].slots;
+        let slot = slots.swap_remove(loc.pos as usize);
+        if let Some(moved) = slots.get(loc.pos as usize) {
+            let idx = moved.handle.index();
+            self.items
+                .get_by_index_mut(idx)
+                .expect("moved item is live")
+                .pos = loc.pos;
         }
-        if next != NIL {
-            self.items.get_by_index_mut(next).expect("next").prev = prev;
-        }
-        self.nodes[node].count -= 1;
-        node
+        slot
     }
 }

@@ -25,7 +25,7 @@ use crate::arena::{Arena, Handle, Pool};
 use crate::broad::{RayHit, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Result};
-use node::{Node, NIL};
+use node::{Node, Slot, NIL};
 use std::ops::ControlFlow;
 
 /// A good density for scenes of many similar spheres moving a little per frame
@@ -45,15 +45,12 @@ pub const MAX_DEPTH_LIMIT: u8 = 64;
 /// point stop after 40 levels instead of recursing until `f32` runs out of bits.
 pub const DEFAULT_MAX_DEPTH: u8 = 40;
 
-/// One stored object: the sphere, its node and its neighbours in the node's
-/// intrusive doubly linked list (arena slot numbers), and the payload.
-#[derive(Clone, Debug)]
-struct Item<T> {
-    sphere: Sphere,
+/// Where a stored object is: its node and its position in the node's `slots`.
+/// The handle arena holds only this; the object itself lives in its node.
+#[derive(Clone, Copy, Debug)]
+struct Loc {
     node: u32,
-    prev: u32,
-    next: u32,
-    value: T,
+    pos: u32,
 }
 
 /// The loose k-d tree of seed 000: a binary, unbalanced tree built lazily over a
@@ -87,10 +84,13 @@ struct Item<T> {
 ///
 /// # Costs
 ///
-/// Memory: one node per occupied cell (`size_of` ≈ 88 bytes) plus one arena slot
-/// per object; both live in pooled arenas with free lists, so steady-state moves do
-/// not allocate. Insert and a move that leaves the node's cell are O(depth); a move
-/// inside the cell is O(1); removal is O(1) plus freeing emptied ancestors. Depth is
+/// Memory: one node per occupied cell (`size_of` ≈ 100 bytes) whose objects
+/// (sphere, handle, payload) are stored contiguously in a vector owned by the node,
+/// plus one small arena slot per object giving its node and position. Nodes live in
+/// a pooled arena with a free list and the vectors of freed nodes are recycled, so
+/// steady-state moves do not allocate. Insert and a move that leaves the node's
+/// cell are O(depth); a move inside the cell is O(1); removal is O(1) (swap with the
+/// node's last object) plus freeing emptied ancestors. Depth is
 /// capped ([`DEFAULT_MAX_DEPTH`], or [`LooseKdTree::with_max_depth`]): at the cap a
 /// node takes every sphere routed to it, so zero-radius spheres on one point end up
 /// in one list rather than recursing forever (queries then scan that list).
@@ -105,8 +105,11 @@ struct Item<T> {
 /// and box queries, which prune with the split planes only, are unaffected.
 #[derive(Clone, Debug)]
 pub struct LooseKdTree<T> {
-    items: Arena<Item<T>>,
-    nodes: Pool<Node>,
+    /// Handle → location; the objects themselves are in their nodes' `slots`.
+    items: Arena<Loc>,
+    nodes: Pool<Node<T>>,
+    /// Emptied `slots` vectors of freed nodes, reused by new nodes.
+    spare: Vec<Vec<Slot<T>>>,
     root: u32,
     world: Aabb,
     r_max: f32,
@@ -156,6 +159,7 @@ impl<T> LooseKdTree<T> {
         let mut t = LooseKdTree {
             items: Arena::new(),
             nodes: Pool::default(),
+            spare: Vec::new(),
             root: NIL,
             world,
             r_max,
@@ -214,42 +218,44 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.cover(&sphere);
         let root = self.ensure_root();
         let node = self.descend(root, &sphere);
-        let h = self.items.insert(Item {
+        let pos = self.nodes[node].slots.len() as u32;
+        let handle = self.items.insert(Loc { node, pos });
+        self.nodes[node].slots.push(Slot {
             sphere,
-            node: NIL,
-            prev: NIL,
-            next: NIL,
+            handle,
             value,
         });
-        self.link(node, h.index());
-        Ok(h)
+        Ok(handle)
     }
 
-    /// Seed `Pop`: O(1) unlink, then frees emptied nodes upwards.
+    /// Seed `Pop`: O(1) swap-remove from the node, then frees emptied nodes upwards.
     fn remove(&mut self, handle: Handle) -> Result<T> {
-        self.items.get(handle)?;
-        let node = self.unlink(handle.index());
-        self.prune_up(node);
-        let item = self.items.remove(handle)?;
+        let loc = *self.items.get(handle)?;
+        let slot = self.take_slot(loc);
+        self.prune_up(loc.node);
+        self.items.remove(handle)?;
         self.reset_span_if_empty();
-        Ok(item.value)
+        Ok(slot.value)
     }
 
     /// Seed `Move`; see the type's docs for when the object changes node.
     fn update(&mut self, handle: Handle, sphere: Sphere) -> Result<()> {
         sphere.validate()?;
-        self.items.get(handle)?;
+        let loc = *self.items.get(handle)?;
         self.cover(&sphere);
-        self.move_item(handle.index(), sphere);
+        self.move_item(loc, sphere);
         Ok(())
     }
 
     fn get(&self, handle: Handle) -> Result<(Sphere, &T)> {
-        self.items.get(handle).map(|it| (it.sphere, &it.value))
+        let loc = self.items.get(handle)?;
+        let slot = &self.nodes[loc.node].slots[loc.pos as usize];
+        Ok((slot.sphere, &slot.value))
     }
 
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
-        self.items.get_mut(handle).map(|it| &mut it.value)
+        let loc = *self.items.get(handle)?;
+        Ok(&mut self.nodes[loc.node].slots[loc.pos as usize].value)
     }
 
     fn len(&self) -> usize {
@@ -260,14 +266,16 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     fn clear(&mut self) {
         self.items.clear();
         self.nodes.clear();
+        self.spare = Vec::new();
         self.root = NIL;
         self.span = self.world;
         self.eps = node::slack(&self.span);
     }
 
     fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
-        for (h, it) in self.items.iter() {
-            f(h, &it.sphere, &it.value);
+        for (_, loc) in self.items.iter() {
+            let slot = &self.nodes[loc.node].slots[loc.pos as usize];
+            f(slot.handle, &slot.sphere, &slot.value);
         }
     }
 
@@ -279,9 +287,8 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.visit_impl(query, f)
     }
 
-    /// Node-vs-node walk (see `pairs.rs`). Each call first copies the tree into a
-    /// depth-first snapshot: O(objects + nodes) time and one scratch allocation of
-    /// about 20 bytes per object and 28 per node.
+    /// Node-vs-node walk over the nodes' contiguous objects (see `pairs.rs`). Uses
+    /// one scratch vector for the carried sets (24 bytes per carried object).
     fn for_each_pair(
         &self,
         f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
@@ -299,8 +306,24 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.validate_impl()
     }
 
-    /// The struct plus the capacity of the item arena and the node pool.
+    /// The struct plus the capacity of the handle arena, the node pool, the nodes'
+    /// object vectors and the spare vectors. O(nodes).
     fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>() + self.items.heap_bytes() + self.nodes.heap_bytes()
+        let slot = std::mem::size_of::<Slot<T>>();
+        let mut slots = self.spare.capacity() * std::mem::size_of::<Vec<Slot<T>>>();
+        slots += self
+            .spare
+            .iter()
+            .map(|v| v.capacity() * slot)
+            .sum::<usize>();
+        if self.root != NIL {
+            let mut stack = vec![self.root];
+            while let Some(n) = stack.pop() {
+                let node = &self.nodes[n];
+                slots += node.slots.capacity() * slot;
+                stack.extend(node.child.into_iter().filter(|&c| c != NIL));
+            }
+        }
+        std::mem::size_of::<Self>() + self.items.heap_bytes() + self.nodes.heap_bytes() + slots
     }
 }

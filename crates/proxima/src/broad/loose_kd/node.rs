@@ -2,15 +2,26 @@
 //! region of a subtree, and a fixed-size traversal stack.
 
 use super::LooseKdTree;
+use crate::arena::Handle;
 use crate::geom::{Aabb, Sphere};
 use glam::Vec3;
 
 /// "No node / no item".
 pub(super) const NIL: u32 = u32::MAX;
 
+/// An object as stored in its node: the node's objects are one contiguous run, so
+/// queries and the pair search read spheres, handles and payloads without going
+/// back to the handle arena.
+#[derive(Clone, Debug)]
+pub(super) struct Slot<T> {
+    pub sphere: Sphere,
+    pub handle: Handle,
+    pub value: T,
+}
+
 /// A tree node (seed `NODE`), flat in a [`Pool`](crate::arena::Pool).
 #[derive(Clone, Debug)]
-pub(super) struct Node {
+pub(super) struct Node<T> {
     /// The seed's box `B`: the world box, narrowed by one face per split above.
     pub bbox: Aabb,
     /// Where the centres of spheres routed through this node lie: per split above,
@@ -28,17 +39,19 @@ pub(super) struct Node {
     pub parent: u32,
     /// `[negative, positive]`.
     pub child: [u32; 2],
-    /// Head of the intrusive item list (arena slot numbers).
-    pub first: u32,
-    /// Items attached here.
-    pub count: u32,
+    /// The objects attached here, in no particular order (removal swaps the last
+    /// one into the hole). The vector is recycled through the tree's spare list
+    /// when the node is freed, so steady-state moves do not allocate.
+    pub slots: Vec<Slot<T>>,
     /// Split axis: the longest of `bbox` (ties to the lower index, as in the seed).
     pub axis: u8,
     pub depth: u8,
 }
 
-impl Node {
-    /// A node over `bbox`; split axis, `m` and `h` are derived from it.
+impl<T> Node<T> {
+    /// A node over `bbox` holding nothing yet (`slots` must be empty: a recycled
+    /// vector); split axis, `m` and `h` are derived from it.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         bbox: Aabb,
         cell: Aabb,
@@ -47,7 +60,9 @@ impl Node {
         depth: u8,
         r_max: f32,
         density: f32,
-    ) -> Node {
+        slots: Vec<Slot<T>>,
+    ) -> Node<T> {
+        debug_assert!(slots.is_empty());
         let (axis, m, h) = split_of(&bbox, r_max, density);
         Node {
             bbox,
@@ -57,8 +72,7 @@ impl Node {
             h_up,
             parent,
             child: [NIL, NIL],
-            first: NIL,
-            count: 0,
+            slots,
             axis,
             depth,
         }
@@ -85,7 +99,7 @@ impl Node {
     /// True when the node holds no item and has no child (it must then be freed).
     #[inline]
     pub fn is_empty(&self) -> bool {
-        self.first == NIL && self.child[0] == NIL && self.child[1] == NIL
+        self.slots.is_empty() && self.child[0] == NIL && self.child[1] == NIL
     }
 
     /// True if the placement rule routes `s` through this node: its centre is on
@@ -135,7 +149,7 @@ impl<T> LooseKdTree<T> {
     /// rounding in the callers' `f32` tests, so pruning never disagrees with the
     /// exact tests of `geom::overlap` on a sphere that touches a face.
     #[inline]
-    pub(super) fn region(&self, n: &Node) -> Aabb {
+    pub(super) fn region(&self, n: &Node<T>) -> Aabb {
         let e = Vec3::splat(self.eps);
         let min = Vec3::select(n.bbox.min.cmpeq(self.world.min), self.span.min, n.bbox.min);
         let max = Vec3::select(n.bbox.max.cmpeq(self.world.max), self.span.max, n.bbox.max);
@@ -145,14 +159,14 @@ impl<T> LooseKdTree<T> {
     /// Lower bound on the split axis of every sphere in the positive subtree of `n`
     /// (`c_a - r > m - h`), minus slack.
     #[inline]
-    pub(super) fn pos_floor(&self, n: &Node) -> f32 {
+    pub(super) fn pos_floor(&self, n: &Node<T>) -> f32 {
         n.m - n.h - self.eps
     }
 
     /// Upper bound on the split axis of every sphere in the negative subtree of `n`
     /// (`c_a + r < m + h`), plus slack.
     #[inline]
-    pub(super) fn neg_ceil(&self, n: &Node) -> f32 {
+    pub(super) fn neg_ceil(&self, n: &Node<T>) -> f32 {
         n.m + n.h + self.eps
     }
 }

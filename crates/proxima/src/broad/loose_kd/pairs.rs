@@ -16,51 +16,23 @@
 //!   overlap only in the border zone `[m - h, m + h]`, so only items near it take
 //!   part on either side.
 //!
-//! The search starts by copying the tree into a [`Flat`] snapshot in depth-first
-//! order: the spheres of each node contiguously, and per node only what the walk
-//! reads (children, the two split-axis bounds, the item range). The walks then
-//! read memory almost linearly instead of chasing list links through the item
-//! arena and scattered node slots; the snapshot costs one pass over the tree.
+//! The walks read each node's objects where they are stored, contiguously in the
+//! node (`Node::slots`); the carried sets are copies of the spheres with the
+//! object's node and position, so the inner loops scan flat arrays and only a
+//! reported pair goes back to the node for its handle and payload.
 
-use super::node::{FixedStack, NIL};
+use super::node::{FixedStack, Slot, NIL};
 use super::LooseKdTree;
 use crate::arena::Handle;
 use crate::geom::{overlap, Sphere};
 use std::ops::ControlFlow;
 
-/// An item in the snapshot or carried down the tree: its sphere and arena slot.
+/// An object carried down the tree: its sphere, node and position in the node.
 #[derive(Clone, Copy, Default)]
 struct Act {
     s: Sphere,
-    idx: u32,
-}
-
-/// A node of the snapshot (indices are snapshot positions).
-#[derive(Clone, Copy)]
-struct FNode {
-    /// `[negative, positive]` children, `NIL` if absent.
-    child: [u32; 2],
-    /// The node's own items: `Flat::s[own[0]..own[1]]`.
-    own: [u32; 2],
-    /// `pos_floor`: every sphere of the positive subtree has `c_a - r >=` this.
-    floor: f32,
-    /// `neg_ceil`: every sphere of the negative subtree has `c_a + r <=` this.
-    ceil: f32,
-    axis: u32,
-}
-
-/// The tree in depth-first order (root at 0, negative child first).
-struct Flat {
-    s: Vec<Act>,
-    n: Vec<FNode>,
-}
-
-impl Flat {
-    #[inline]
-    fn own(&self, n: u32) -> &[Act] {
-        let [a, b] = self.n[n as usize].own;
-        &self.s[a as usize..b as usize]
-    }
+    node: u32,
+    pos: u32,
 }
 
 /// Appends to `buf` the entries of `buf[from..to]` that reach `bound` on `axis`
@@ -92,74 +64,32 @@ impl<T> LooseKdTree<T> {
         if self.root == NIL {
             return ControlFlow::Continue(());
         }
-        let mut fl = Flat {
-            s: Vec::with_capacity(self.items.len()),
-            n: Vec::with_capacity(self.nodes.len()),
-        };
-        self.flatten(self.root, &mut fl);
         let mut buf: Vec<Act> = Vec::with_capacity(1024);
-        self.self_pairs(&fl, 0, 0, &mut buf, &mut f)
+        self.self_pairs(self.root, 0, &mut buf, &mut f)
     }
 
-    /// Appends the subtree of `n` to the snapshot; returns its position.
-    fn flatten(&self, n: u32, fl: &mut Flat) -> u32 {
-        let node = &self.nodes[n];
-        let start = fl.s.len() as u32;
-        let mut it = node.first;
-        while it != NIL {
-            let item = self.items.get_by_index(it).expect("listed item").1;
-            fl.s.push(Act {
-                s: item.sphere,
-                idx: it,
-            });
-            it = item.next;
-        }
-        let at = fl.n.len();
-        fl.n.push(FNode {
-            child: [NIL; 2],
-            own: [start, fl.s.len() as u32],
-            floor: self.pos_floor(node),
-            ceil: self.neg_ceil(node),
-            axis: node.axis as u32,
-        });
-        for side in 0..2 {
-            if node.child[side] != NIL {
-                let c = self.flatten(node.child[side], fl);
-                fl.n[at].child[side] = c;
-            }
-        }
-        at as u32
-    }
-
+    /// Reports carried object `x` with stored object `y`.
     #[inline]
     fn report(
         &self,
-        a: u32,
-        b: u32,
+        x: &Act,
+        y: &Slot<T>,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let (ha, ia) = self.items.get_by_index(a).expect("live item");
-        let (hb, ib) = self.items.get_by_index(b).expect("live item");
-        f(ha, &ia.value, hb, &ib.value)
+        let xs = &self.nodes[x.node].slots[x.pos as usize];
+        f(xs.handle, &xs.value, y.handle, &y.value)
     }
 
     /// Appends to `buf` the entries of `buf[from..to]` that can reach child `side`
     /// of `n`: one comparison on the split axis.
     #[inline]
-    fn filter_into_child(
-        fl: &Flat,
-        n: u32,
-        side: usize,
-        from: usize,
-        to: usize,
-        buf: &mut Vec<Act>,
-    ) {
-        let node = &fl.n[n as usize];
+    fn filter_into_child(&self, n: u32, side: usize, from: usize, to: usize, buf: &mut Vec<Act>) {
+        let node = &self.nodes[n];
         let a = node.axis as usize;
         if side == 1 {
-            refilter(buf, from, to, a, node.floor, true);
+            refilter(buf, from, to, a, self.pos_floor(node), true);
         } else {
-            refilter(buf, from, to, a, node.ceil, false);
+            refilter(buf, from, to, a, self.neg_ceil(node), false);
         }
     }
 
@@ -167,35 +97,43 @@ impl<T> LooseKdTree<T> {
     /// `buf[active..]` (ancestors' items that reach `n`'s region).
     fn self_pairs(
         &self,
-        fl: &Flat,
         n: u32,
         active: usize,
         buf: &mut Vec<Act>,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let node = fl.n[n as usize];
-        let own = fl.own(n);
-        // Each item against the active set and the node's earlier items.
+        let node = &self.nodes[n];
+        let own = &node.slots[..];
+        // Each object against the active set and the node's earlier objects.
         for (i, y) in own.iter().enumerate() {
-            for x in buf[active..].iter().chain(&own[..i]) {
-                if overlap::sphere_sphere(&x.s, &y.s) {
-                    self.report(x.idx, y.idx, f)?;
+            for x in &buf[active..] {
+                if overlap::sphere_sphere(&x.s, &y.sphere) {
+                    self.report(x, y, f)?;
+                }
+            }
+            for x in &own[..i] {
+                if overlap::sphere_sphere(&x.sphere, &y.sphere) {
+                    f(x.handle, &x.value, y.handle, &y.value)?;
                 }
             }
         }
-        buf.extend_from_slice(own);
+        buf.extend(own.iter().enumerate().map(|(pos, x)| Act {
+            s: x.sphere,
+            node: n,
+            pos: pos as u32,
+        }));
         let end = buf.len();
         for side in 0..2 {
             let c = node.child[side];
             if c == NIL {
                 continue;
             }
-            Self::filter_into_child(fl, n, side, active, end, buf);
-            self.self_pairs(fl, c, end, buf, f)?;
+            self.filter_into_child(n, side, active, end, buf);
+            self.self_pairs(c, end, buf, f)?;
             buf.truncate(end);
         }
         if node.child[0] != NIL && node.child[1] != NIL {
-            self.cross(fl, n, buf, f)?;
+            self.cross(n, buf, f)?;
         }
         ControlFlow::Continue(())
     }
@@ -203,17 +141,17 @@ impl<T> LooseKdTree<T> {
     /// Every pair between the subtrees of the two children of `a`.
     fn cross(
         &self,
-        fl: &Flat,
         a: u32,
         buf: &mut Vec<Act>,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let base = buf.len();
-        let parent = fl.n[a as usize];
+        let parent = &self.nodes[a];
         let axis = parent.axis as usize;
-        self.gather(fl, parent.child[0], axis, parent.floor, buf);
+        self.gather(parent.child[0], axis, self.pos_floor(parent), buf);
         if buf.len() > base {
-            self.walk(fl, parent.child[1], base, (axis, parent.ceil), buf, f)?;
+            let border = (axis, self.neg_ceil(parent));
+            self.walk(parent.child[1], base, border, buf, f)?;
         }
         buf.truncate(base);
         ControlFlow::Continue(())
@@ -227,22 +165,25 @@ impl<T> LooseKdTree<T> {
     /// `floor` overlaps none of them. Inside `p`, only a negative child of a split
     /// on the same axis lowers the upper bound of its spheres (to `m + h`), so it
     /// is skipped when that bound is below `floor`; every other child may reach.
-    fn gather(&self, fl: &Flat, p: u32, axis: usize, floor: f32, buf: &mut Vec<Act>) {
+    fn gather(&self, p: u32, axis: usize, floor: f32, buf: &mut Vec<Act>) {
         let mut stack = FixedStack::<u32>::new();
         stack.push(p);
         while let Some(n) = stack.pop() {
-            let node = &fl.n[n as usize];
-            let own = fl.own(n);
+            let node = &self.nodes[n];
             let base = buf.len();
-            buf.resize(base + own.len(), Act::default());
+            buf.resize(base + node.slots.len(), Act::default());
             let mut k = base;
-            for x in own {
-                buf[k] = *x;
-                k += (x.s.center[axis] + x.s.radius >= floor) as usize;
+            for (pos, x) in node.slots.iter().enumerate() {
+                buf[k] = Act {
+                    s: x.sphere,
+                    node: n,
+                    pos: pos as u32,
+                };
+                k += (x.sphere.center[axis] + x.sphere.radius >= floor) as usize;
             }
             buf.truncate(k);
             let [neg, pos] = node.child;
-            if neg != NIL && (node.axis as usize != axis || node.ceil >= floor) {
+            if neg != NIL && (node.axis as usize != axis || self.neg_ceil(node) >= floor) {
                 stack.push(neg);
             }
             if pos != NIL {
@@ -256,23 +197,22 @@ impl<T> LooseKdTree<T> {
     /// active set `buf[active..]`.
     fn walk(
         &self,
-        fl: &Flat,
         n: u32,
         active: usize,
         border: (usize, f32),
         buf: &mut Vec<Act>,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let node = fl.n[n as usize];
+        let node = &self.nodes[n];
         let end = buf.len();
         let (axis, ceil) = border;
-        for y in fl.own(n) {
-            if y.s.center[axis] - y.s.radius > ceil {
+        for y in &node.slots {
+            if y.sphere.center[axis] - y.sphere.radius > ceil {
                 continue;
             }
             for x in &buf[active..end] {
-                if overlap::sphere_sphere(&x.s, &y.s) {
-                    self.report(x.idx, y.idx, f)?;
+                if overlap::sphere_sphere(&x.s, &y.sphere) {
+                    self.report(x, y, f)?;
                 }
             }
         }
@@ -281,9 +221,9 @@ impl<T> LooseKdTree<T> {
             if c == NIL {
                 continue;
             }
-            Self::filter_into_child(fl, n, side, active, end, buf);
+            self.filter_into_child(n, side, active, end, buf);
             if buf.len() > end {
-                self.walk(fl, c, end, border, buf, f)?;
+                self.walk(c, end, border, buf, f)?;
             }
             buf.truncate(end);
         }

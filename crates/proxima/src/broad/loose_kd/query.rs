@@ -60,13 +60,10 @@ impl<T> LooseKdTree<T> {
         classify(self.root, Frustum::ALL_PLANES, &mut stack);
         while let Some(p) = stack.pop() {
             let node = &self.nodes[p.node];
-            let mut it = node.first;
-            while it != NIL {
-                let (h, item) = self.items.get_by_index(it).expect("listed item");
-                if p.inside || query.selects(&item.sphere) {
-                    f(h, &item.sphere, &item.value)?;
+            for slot in &node.slots {
+                if p.inside || query.selects(&slot.sphere) {
+                    f(slot.handle, &slot.sphere, &slot.value)?;
                 }
-                it = item.next;
             }
             let a = node.axis as usize;
             for side in 0..2 {
@@ -119,10 +116,9 @@ impl<T> LooseKdTree<T> {
                 continue;
             }
             let node = &self.nodes[n];
-            let mut it = node.first;
-            while it != NIL {
-                let (h, item) = self.items.get_by_index(it).expect("listed item");
-                if let Some(t) = overlap::ray_sphere(&r, &item.sphere) {
+            for slot in &node.slots {
+                let h = slot.handle;
+                if let Some(t) = overlap::ray_sphere(&r, &slot.sphere) {
                     let better = match best {
                         None => true,
                         Some(b) => (t, h) < (b.t, b.handle),
@@ -132,7 +128,6 @@ impl<T> LooseKdTree<T> {
                         r.max_t = t;
                     }
                 }
-                it = item.next;
             }
             let mut entries = [(NIL, f32::INFINITY); 2];
             for (side, e) in entries.iter_mut().enumerate() {

@@ -53,8 +53,8 @@ impl<T> LooseKdTree<T> {
             if s.items_per_depth.len() <= d {
                 s.items_per_depth.resize(d + 1, 0);
             }
-            s.items_per_depth[d] += node.count as usize;
-            s.max_items_per_node = s.max_items_per_node.max(node.count as usize);
+            s.items_per_depth[d] += node.slots.len();
+            s.max_items_per_node = s.max_items_per_node.max(node.slots.len());
             if node.child == [NIL, NIL] {
                 s.leaves += 1;
             }
@@ -65,8 +65,8 @@ impl<T> LooseKdTree<T> {
 
     /// The node an object is attached to. O(1). Errors on a stale handle.
     pub fn placement(&self, handle: Handle) -> Result<Placement> {
-        let item = self.items.get(handle)?;
-        let n = &self.nodes[item.node];
+        let loc = self.items.get(handle)?;
+        let n = &self.nodes[loc.node];
         Ok(Placement {
             depth: n.depth as usize,
             node_box: n.bbox,

@@ -1,7 +1,7 @@
 //! Removal of emptied nodes (seed `DeleteNode`) and moves (seed `Move`).
 
 use super::node::NIL;
-use super::LooseKdTree;
+use super::{Loc, LooseKdTree};
 use crate::geom::Sphere;
 
 impl<T> LooseKdTree<T> {
@@ -12,6 +12,9 @@ impl<T> LooseKdTree<T> {
             return None;
         }
         let p = self.nodes[n].parent;
+        // Keep the (empty) vector's capacity for the next node created.
+        let slots = std::mem::take(&mut self.nodes[n].slots);
+        self.spare.push(slots);
         if p == NIL {
             self.root = NIL;
         } else {
@@ -32,28 +35,23 @@ impl<T> LooseKdTree<T> {
         }
     }
 
-    /// Moves item slot `idx` to `s` (already validated and covered by `span`).
+    /// Moves the object at `loc` to `s` (already validated and covered by `span`).
     ///
-    /// If the placement rule still puts `s` in the item's node (same side of every
+    /// If the placement rule still puts `s` in the object's node (same side of every
     /// split above, `r` below every `h` above and `>= h` here or at the depth cap),
-    /// only the stored sphere changes: O(1). Otherwise the item is unlinked and we
-    /// climb, freeing emptied nodes, to the lowest node that still routes `s` (the
-    /// root always does), and insert from there: O(climb + descent).
-    pub(super) fn move_item(&mut self, idx: u32, s: Sphere) {
-        let node = self
-            .items
-            .get_by_index(idx)
-            .expect("moving a live item")
-            .1
-            .node;
-        let n = &self.nodes[node];
-        let stays = n.routes(&s) && (s.radius >= n.h || n.depth >= self.max_depth);
-        self.items.get_by_index_mut(idx).expect("live").sphere = s;
-        if stays {
+    /// only the stored sphere changes: O(1). Otherwise the object is taken out of
+    /// the node and we climb, freeing emptied nodes, to the lowest node that still
+    /// routes `s` (the root always does), and insert from there: O(climb + descent).
+    pub(super) fn move_item(&mut self, loc: Loc, s: Sphere) {
+        let max_depth = self.max_depth;
+        let n = &mut self.nodes[loc.node];
+        if n.routes(&s) && (s.radius >= n.h || n.depth >= max_depth) {
+            n.slots[loc.pos as usize].sphere = s;
             return;
         }
-        self.unlink(idx);
-        let mut cur = node;
+        let mut slot = self.take_slot(loc);
+        slot.sphere = s;
+        let mut cur = loc.node;
         while !self.nodes[cur].routes(&s) {
             let parent = self.nodes[cur].parent;
             debug_assert!(parent != NIL, "the root routes every sphere");
@@ -61,6 +59,6 @@ impl<T> LooseKdTree<T> {
             cur = parent;
         }
         let target = self.descend(cur, &s);
-        self.link(target, idx);
+        self.put_slot(target, slot);
     }
 }

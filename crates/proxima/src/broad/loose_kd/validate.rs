@@ -12,8 +12,9 @@ impl<T> LooseKdTree<T> {
     /// Checks: arena and pool free lists; parent/child links; each node's box,
     /// cell, split axis, `m`, `h` and `h_up` re-derived from its parent (the root's
     /// from the world box); `h` never growing downwards; the depth cap; no empty
-    /// node; every item list's links, owner and count; every item placed exactly
-    /// where the placement rule puts it; `span` covering the world and every
+    /// node; every stored object's handle live and locating exactly its slot, and
+    /// every object placed exactly where the placement rule puts it (with the
+    /// object count, this makes handles and slots a bijection); spare vectors empty; `span` covering the world and every
     /// sphere. O(nodes + items).
     pub(super) fn validate_impl(&self) -> Result<()> {
         self.items.validate()?;
@@ -27,6 +28,9 @@ impl<T> LooseKdTree<T> {
                 return fail(format!("node slot {i} freed twice"));
             }
             *seen = true;
+        }
+        if self.spare.iter().any(|v| !v.is_empty()) {
+            return fail("a spare object vector is not empty".into());
         }
         if !self.span.contains_aabb(&self.world) || self.eps != slack(&self.span) {
             return fail("span does not cover the world or eps is stale".into());
@@ -87,39 +91,30 @@ impl<T> LooseKdTree<T> {
             if node.is_empty() {
                 return fail(format!("node {n}: empty node not freed"));
             }
-            // Item list.
-            let mut count = 0u32;
-            let mut prev = NIL;
-            let mut it = node.first;
-            while it != NIL {
-                let Some((_, item)) = self.items.get_by_index(it) else {
-                    return fail(format!("node {n} lists dead item slot {it}"));
-                };
-                if item.node != n || item.prev != prev {
-                    return fail(format!("item slot {it}: owner or prev link wrong"));
+            // Objects: each one's handle is live and locates exactly this slot,
+            // and it sits where the placement rule puts it.
+            for (pos, slot) in node.slots.iter().enumerate() {
+                match self.items.get(slot.handle) {
+                    Ok(loc) if loc.node == n && loc.pos as usize == pos => {}
+                    _ => {
+                        return fail(format!(
+                            "node {n} slot {pos}: handle dead or located elsewhere"
+                        ))
+                    }
                 }
-                count += 1;
-                if count > node.count {
-                    return fail(format!("node {n}: list longer than its count"));
-                }
-                let s = &item.sphere;
+                let s = &slot.sphere;
                 let here = s.radius >= node.h || node.depth >= self.max_depth;
                 if !node.routes(s) || !here {
                     return fail(format!(
-                        "item slot {it} at node {n} (depth {}) breaks the placement rule",
+                        "object in node {n} (depth {}) breaks the placement rule",
                         node.depth
                     ));
                 }
                 if !self.span.contains_aabb(&s.aabb()) {
-                    return fail(format!("item slot {it} outside span"));
+                    return fail(format!("object in node {n} outside span"));
                 }
-                prev = it;
-                it = item.next;
             }
-            if count != node.count {
-                return fail(format!("node {n}: count {} but {count} listed", node.count));
-            }
-            items_seen += count as usize;
+            items_seen += node.slots.len();
             for c in node.child {
                 if c != NIL {
                     if (c as usize) >= slots || free[c as usize] || self.nodes[c].parent != n {

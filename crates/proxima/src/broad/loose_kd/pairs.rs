@@ -35,25 +35,62 @@ struct Act {
     pos: u32,
 }
 
+/// Below this many objects in a node (own plus carried), the node's tests are
+/// all-pairs; from it on they use a sweep on the split axis.
+const SWEEP_MIN: usize = 48;
+
+/// Scratch of the sweep: the spheres (carried first, then own) and their sort
+/// keys (lower end on the sweep axis, index into `sp`).
+#[derive(Default)]
+struct Sweep {
+    sp: Vec<Sphere>,
+    keys: Vec<(f32, u32)>,
+}
+
 /// Appends to `buf` the entries of `buf[from..to]` that reach `bound` on `axis`
 /// from below (`c_a + r >= bound`, `upper`) or stay under it (`c_a - r <= bound`).
-/// Branch-free: every entry is written, the end advances only for kept ones.
 #[inline]
 fn refilter(buf: &mut Vec<Act>, from: usize, to: usize, axis: usize, bound: f32, upper: bool) {
+    match (axis, upper) {
+        (0, true) => refilter_on::<0, true>(buf, from, to, bound),
+        (1, true) => refilter_on::<1, true>(buf, from, to, bound),
+        (_, true) => refilter_on::<2, true>(buf, from, to, bound),
+        (0, false) => refilter_on::<0, false>(buf, from, to, bound),
+        (1, false) => refilter_on::<1, false>(buf, from, to, bound),
+        (_, false) => refilter_on::<2, false>(buf, from, to, bound),
+    }
+}
+
+/// [`refilter`] for one axis and direction (compiled separately, so the
+/// coordinate is a field access, not an index). Branch-free: the range is copied
+/// to the end in one block, then compacted in place (every entry is written, the
+/// end advances only for kept ones).
+fn refilter_on<const A: usize, const UPPER: bool>(
+    buf: &mut Vec<Act>,
+    from: usize,
+    to: usize,
+    bound: f32,
+) {
     let base = buf.len();
-    buf.resize(base + (to - from), Act::default());
-    let mut k = base;
-    for i in from..to {
-        let x = buf[i];
-        let keep = if upper {
-            x.s.center[axis] + x.s.radius >= bound
-        } else {
-            x.s.center[axis] - x.s.radius <= bound
+    buf.extend_from_within(from..to);
+    let tail = &mut buf[base..];
+    let mut k = 0;
+    for i in 0..tail.len() {
+        let x = tail[i];
+        let c = match A {
+            0 => x.s.center.x,
+            1 => x.s.center.y,
+            _ => x.s.center.z,
         };
-        buf[k] = x;
+        let keep = if UPPER {
+            c + x.s.radius >= bound
+        } else {
+            c - x.s.radius <= bound
+        };
+        tail[k] = x;
         k += keep as usize;
     }
-    buf.truncate(k);
+    buf.truncate(base + k);
 }
 
 impl<T> LooseKdTree<T> {
@@ -65,7 +102,8 @@ impl<T> LooseKdTree<T> {
             return ControlFlow::Continue(());
         }
         let mut buf: Vec<Act> = Vec::with_capacity(1024);
-        self.self_pairs(self.root, 0, &mut buf, &mut f)
+        let mut sw = Sweep::default();
+        self.self_pairs(self.root, 0, &mut buf, &mut sw, &mut f)
     }
 
     /// Reports carried object `x` with stored object `y`.
@@ -100,22 +138,15 @@ impl<T> LooseKdTree<T> {
         n: u32,
         active: usize,
         buf: &mut Vec<Act>,
+        sw: &mut Sweep,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let node = &self.nodes[n];
         let own = &node.slots[..];
-        // Each object against the active set and the node's earlier objects.
-        for (i, y) in own.iter().enumerate() {
-            for x in &buf[active..] {
-                if overlap::sphere_sphere(&x.s, &y.sphere) {
-                    self.report(x, y, f)?;
-                }
-            }
-            for x in &own[..i] {
-                if overlap::sphere_sphere(&x.sphere, &y.sphere) {
-                    f(x.handle, &x.value, y.handle, &y.value)?;
-                }
-            }
+        if own.len() > 1 && buf.len() - active + own.len() >= SWEEP_MIN {
+            self.sweep(&buf[active..], own, node.axis as usize, sw, f)?;
+        } else {
+            self.brute(&buf[active..], own, f)?;
         }
         buf.extend(own.iter().enumerate().map(|(pos, x)| Act {
             s: x.sphere,
@@ -129,11 +160,91 @@ impl<T> LooseKdTree<T> {
                 continue;
             }
             self.filter_into_child(n, side, active, end, buf);
-            self.self_pairs(c, end, buf, f)?;
+            self.self_pairs(c, end, buf, sw, f)?;
             buf.truncate(end);
         }
         if node.child[0] != NIL && node.child[1] != NIL {
             self.cross(n, buf, f)?;
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Every overlapping pair among `own` and between `act` and `own`, by testing
+    /// all of them: for nodes with few objects.
+    fn brute(
+        &self,
+        act: &[Act],
+        own: &[Slot<T>],
+        f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        for (i, y) in own.iter().enumerate() {
+            for x in act {
+                if overlap::sphere_sphere(&x.s, &y.sphere) {
+                    self.report(x, y, f)?;
+                }
+            }
+            for x in &own[..i] {
+                if overlap::sphere_sphere(&x.sphere, &y.sphere) {
+                    f(x.handle, &x.value, y.handle, &y.value)?;
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// The same pairs as [`Self::brute`], by a sweep on `axis`: the objects are
+    /// sorted by their lower end on `axis`, and each is tested only against the
+    /// following ones that start before it ends. The big objects of a node high
+    /// in the tree are spread over its whole box, so most of them are far apart
+    /// and the sweep skips them; sorting costs O(k log k) for k objects.
+    ///
+    /// Why no pair is missed: overlapping spheres (closed, as `overlap`
+    /// computes it in `f32`) have centres at most `r_a + r_b` apart on every axis,
+    /// so their intervals on `axis` meet; `eps` absorbs the rounding of the
+    /// interval ends.
+    fn sweep(
+        &self,
+        act: &[Act],
+        own: &[Slot<T>],
+        axis: usize,
+        sw: &mut Sweep,
+        f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        let na = act.len() as u32;
+        sw.sp.clear();
+        sw.sp.extend(act.iter().map(|x| x.s));
+        sw.sp.extend(own.iter().map(|x| x.sphere));
+        sw.keys.clear();
+        let sp = &sw.sp;
+        sw.keys.extend(
+            sp.iter()
+                .enumerate()
+                .map(|(i, s)| (s.center[axis] - s.radius, i as u32)),
+        );
+        sw.keys.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let slot = |i: u32| -> &Slot<T> {
+            if i < na {
+                let x = &act[i as usize];
+                &self.nodes[x.node].slots[x.pos as usize]
+            } else {
+                &own[(i - na) as usize]
+            }
+        };
+        let keys = &sw.keys[..];
+        for (k, &(_, i)) in keys.iter().enumerate() {
+            let si = &sp[i as usize];
+            let hi = si.center[axis] + si.radius + self.eps;
+            for &(lo, j) in &keys[k + 1..] {
+                if lo > hi {
+                    break;
+                }
+                // Two carried objects were paired higher up.
+                if (i < na && j < na) || !overlap::sphere_sphere(si, &sp[j as usize]) {
+                    continue;
+                }
+                let (a, b) = (slot(i), slot(j));
+                f(a.handle, &a.value, b.handle, &b.value)?;
+            }
         }
         ControlFlow::Continue(())
     }

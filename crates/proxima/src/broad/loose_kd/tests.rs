@@ -287,3 +287,70 @@ fn stale_handles_and_bad_spheres_change_nothing() {
     assert!(t.placement(h).is_err());
     t.validate().unwrap();
 }
+
+/// Unordered pairs of payloads reported by `for_each_pair`, sorted; panics on a
+/// pair reported twice.
+fn value_pairs<I: SpatialIndex<u32>>(t: &I) -> Vec<(u32, u32)> {
+    let mut v = Vec::new();
+    let _ = t.for_each_pair(|_, a, _, b| {
+        v.push((*a.min(b), *a.max(b)));
+        ControlFlow::Continue(())
+    });
+    v.sort_unstable();
+    let n = v.len();
+    v.dedup();
+    assert_eq!(v.len(), n, "a pair was reported twice");
+    v
+}
+
+#[test]
+fn crowded_nodes_sweep_finds_exactly_touching_pairs() {
+    // Big spheres on a grid whose spacing equals the sum of radii (every grid
+    // neighbour touches exactly) all stop at the root, so the root's own test and
+    // the carried sets of the nodes below are far above the sweep threshold.
+    let world = cube(20.0);
+    let mut t = LooseKdTree::new(world, 2.0, 0.2).unwrap();
+    let mut b = BruteForce::new();
+    let mut rng = Pcg64::seed_from_u64(17);
+    let mut hs = Vec::new();
+    let mut v = 0u32;
+    for x in 0..7 {
+        for y in 0..7 {
+            for z in 0..7 {
+                let s = Sphere::new(vec3(x as f32, y as f32, z as f32) * 3.0, 1.5);
+                hs.push((t.insert(s, v).unwrap(), b.insert(s, v).unwrap()));
+                v += 1;
+            }
+        }
+    }
+    for _ in 0..600 {
+        let c = vec3(
+            rng.gen_range(0.0..20.0),
+            rng.gen_range(0.0..20.0),
+            rng.gen_range(0.0..20.0),
+        );
+        let s = Sphere::new(c, rng.gen_range(0.05..0.6));
+        hs.push((t.insert(s, v).unwrap(), b.insert(s, v).unwrap()));
+        v += 1;
+    }
+    assert!(t.stats().max_items_per_node >= 343);
+    let expect = value_pairs(&b);
+    assert!(expect.len() >= 3 * 6 * 49, "grid neighbours touch");
+    assert_eq!(value_pairs(&t), expect);
+    // Small moves, some of them changing node.
+    for _ in 0..5 {
+        for &(ht, hb) in &hs {
+            let (s, _) = t.get(ht).unwrap();
+            let d = vec3(
+                rng.gen_range(-0.3..0.3),
+                rng.gen_range(-0.3..0.3),
+                rng.gen_range(-0.3..0.3),
+            );
+            let s = Sphere::new(s.center + d, s.radius);
+            t.update(ht, s).unwrap();
+            b.update(hb, s).unwrap();
+        }
+        t.validate().unwrap();
+        assert_eq!(value_pairs(&t), value_pairs(&b));
+    }
+}

@@ -39,6 +39,10 @@ struct Act {
 /// all-pairs; from it on they use a sweep on the split axis.
 const SWEEP_MIN: usize = 48;
 
+/// Leaves with fewer objects are tested against their parent's carried set
+/// without narrowing it first (see `worth_filtering`).
+const LEAF_FILTER_MIN: usize = 8;
+
 /// Scratch of the sweep: the spheres (carried first, then own) and their sort
 /// keys (lower end on the sweep axis, index into `sp`).
 #[derive(Default)]
@@ -118,6 +122,17 @@ impl<T> LooseKdTree<T> {
         f(xs.handle, &xs.value, y.handle, &y.value)
     }
 
+    /// Whether to narrow the carried set before visiting node `c`. The filter only
+    /// saves work (a superset of the objects that can reach `c` gives the same
+    /// pairs): it costs a copy per carried object, and for a leaf with few objects
+    /// that is more than the sphere tests it saves, so such a leaf is tested
+    /// against its parent's set as it is.
+    #[inline]
+    fn worth_filtering(&self, c: u32) -> bool {
+        let node = &self.nodes[c];
+        node.child != [NIL, NIL] || node.slots.len() >= LEAF_FILTER_MIN
+    }
+
     /// Appends to `buf` the entries of `buf[from..to]` that can reach child `side`
     /// of `n`: one comparison on the split axis.
     #[inline]
@@ -159,8 +174,12 @@ impl<T> LooseKdTree<T> {
             if c == NIL {
                 continue;
             }
-            self.filter_into_child(n, side, active, end, buf);
-            self.self_pairs(c, end, buf, sw, f)?;
+            if self.worth_filtering(c) {
+                self.filter_into_child(n, side, active, end, buf);
+                self.self_pairs(c, end, buf, sw, f)?;
+            } else {
+                self.self_pairs(c, active, buf, sw, f)?;
+            }
             buf.truncate(end);
         }
         if node.child[0] != NIL && node.child[1] != NIL {
@@ -332,9 +351,13 @@ impl<T> LooseKdTree<T> {
             if c == NIL {
                 continue;
             }
-            self.filter_into_child(n, side, active, end, buf);
-            if buf.len() > end {
-                self.walk(c, end, border, buf, f)?;
+            if self.worth_filtering(c) {
+                self.filter_into_child(n, side, active, end, buf);
+                if buf.len() > end {
+                    self.walk(c, end, border, buf, f)?;
+                }
+            } else {
+                self.walk(c, active, border, buf, f)?;
             }
             buf.truncate(end);
         }

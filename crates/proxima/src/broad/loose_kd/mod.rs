@@ -110,6 +110,8 @@ pub struct LooseKdTree<T> {
     nodes: Pool<Node<T>>,
     /// Emptied `slots` vectors of freed nodes, reused by new nodes.
     spare: Vec<Vec<Slot<T>>>,
+    /// Buffers of the pair search, reused between calls.
+    scratch: pairs::PairScratch,
     root: u32,
     world: Aabb,
     r_max: f32,
@@ -160,6 +162,7 @@ impl<T> LooseKdTree<T> {
             items: Arena::new(),
             nodes: Pool::default(),
             spare: Vec::new(),
+            scratch: Default::default(),
             root: NIL,
             world,
             r_max,
@@ -267,6 +270,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.items.clear();
         self.nodes.clear();
         self.spare = Vec::new();
+        self.scratch = Default::default();
         self.root = NIL;
         self.span = self.world;
         self.eps = node::slack(&self.span);
@@ -287,8 +291,9 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.visit_impl(query, f)
     }
 
-    /// Node-vs-node walk over the nodes' contiguous objects (see `pairs.rs`). Uses
-    /// one scratch vector for the carried sets (24 bytes per carried object).
+    /// Node-vs-node walk over the nodes' contiguous objects (see `pairs.rs`). Its
+    /// buffers (24 bytes per carried object) are kept in the tree and reused, so
+    /// repeated calls do not allocate once they have grown.
     fn for_each_pair(
         &self,
         f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
@@ -307,7 +312,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     }
 
     /// The struct plus the capacity of the handle arena, the node pool, the nodes'
-    /// object vectors and the spare vectors. O(nodes).
+    /// object vectors, the spare vectors and the pair-search buffers. O(nodes).
     fn memory_bytes(&self) -> usize {
         let slot = std::mem::size_of::<Slot<T>>();
         let mut slots = self.spare.capacity() * std::mem::size_of::<Vec<Slot<T>>>();
@@ -324,6 +329,10 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
                 stack.extend(node.child.into_iter().filter(|&c| c != NIL));
             }
         }
-        std::mem::size_of::<Self>() + self.items.heap_bytes() + self.nodes.heap_bytes() + slots
+        std::mem::size_of::<Self>()
+            + self.items.heap_bytes()
+            + self.nodes.heap_bytes()
+            + self.scratch.heap_bytes()
+            + slots
     }
 }

@@ -26,6 +26,7 @@ use super::LooseKdTree;
 use crate::arena::Handle;
 use crate::geom::{overlap, Sphere};
 use std::ops::ControlFlow;
+use std::sync::{Mutex, TryLockError};
 
 /// An object carried down the tree: its sphere, node and position in the node.
 #[derive(Clone, Copy, Default)]
@@ -49,6 +50,45 @@ const LEAF_FILTER_MIN: usize = 8;
 struct Sweep {
     sp: Vec<Sphere>,
     keys: Vec<(f32, u32)>,
+}
+
+/// The pair search's buffers, kept in the tree between calls so that a
+/// steady-state `for_each_pair` does not allocate. Behind a mutex because the
+/// search takes `&self`; a call that finds it taken (a concurrent or nested
+/// search) uses fresh buffers instead. Cloning gives empty buffers.
+#[derive(Default)]
+pub(super) struct PairScratch(Mutex<Buffers>);
+
+#[derive(Default)]
+struct Buffers {
+    buf: Vec<Act>,
+    sw: Sweep,
+}
+
+impl Clone for PairScratch {
+    fn clone(&self) -> Self {
+        PairScratch::default()
+    }
+}
+
+impl std::fmt::Debug for PairScratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("PairScratch")
+    }
+}
+
+impl PairScratch {
+    /// Heap bytes held by the buffers (0 if they are in use).
+    pub(super) fn heap_bytes(&self) -> usize {
+        match self.0.try_lock() {
+            Ok(b) => {
+                b.buf.capacity() * std::mem::size_of::<Act>()
+                    + b.sw.sp.capacity() * std::mem::size_of::<Sphere>()
+                    + b.sw.keys.capacity() * std::mem::size_of::<(f32, u32)>()
+            }
+            Err(_) => 0,
+        }
+    }
 }
 
 /// Appends to `buf` the entries of `buf[from..to]` that reach `bound` on `axis`
@@ -105,9 +145,17 @@ impl<T> LooseKdTree<T> {
         if self.root == NIL {
             return ControlFlow::Continue(());
         }
-        let mut buf: Vec<Act> = Vec::with_capacity(1024);
-        let mut sw = Sweep::default();
-        self.self_pairs(self.root, 0, &mut buf, &mut sw, &mut f)
+        let mut fresh = Buffers::default();
+        let mut guard = match self.scratch.0.try_lock() {
+            Ok(g) => Some(g),
+            // A panic in an earlier callback left the buffers in some state; they
+            // are cleared below anyway.
+            Err(TryLockError::Poisoned(p)) => Some(p.into_inner()),
+            Err(TryLockError::WouldBlock) => None,
+        };
+        let b = guard.as_deref_mut().unwrap_or(&mut fresh);
+        b.buf.clear();
+        self.self_pairs(self.root, 0, &mut b.buf, &mut b.sw, &mut f)
     }
 
     /// Reports carried object `x` with stored object `y`.

@@ -354,3 +354,30 @@ fn crowded_nodes_sweep_finds_exactly_touching_pairs() {
         assert_eq!(value_pairs(&t), value_pairs(&b));
     }
 }
+
+#[test]
+fn nested_pair_searches_use_their_own_buffers() {
+    let mut t = LooseKdTree::new(cube(20.0), 2.0, 0.2).unwrap();
+    let mut rng = Pcg64::seed_from_u64(5);
+    for i in 0..500u32 {
+        let c = vec3(
+            rng.gen_range(0.0..20.0),
+            rng.gen_range(0.0..20.0),
+            rng.gen_range(0.0..20.0),
+        );
+        t.insert(Sphere::new(c, rng.gen_range(0.1..1.5)), i)
+            .unwrap();
+    }
+    let outer = value_pairs(&t);
+    assert!(!outer.is_empty());
+    // A callback that runs a whole search itself, while the outer one holds the
+    // tree's buffers: both must see every pair.
+    let mut seen = 0;
+    let _ = t.for_each_pair(|_, _, _, _| {
+        assert_eq!(value_pairs(&t), outer);
+        seen += 1;
+        ControlFlow::Break(())
+    });
+    assert_eq!(seen, 1);
+    assert_eq!(value_pairs(&t), outer, "buffers still usable afterwards");
+}

@@ -3,7 +3,8 @@
 //! design §2.1.
 //!
 //! Files, one concern each: `node.rs` (node layout, box derivation, conservative
-//! regions), `insert.rs` (the placement rule, node creation, item lists),
+//! regions, the per-node object vectors), `insert.rs` (the placement rule, node
+//! creation, placing and swap-removing objects),
 //! `update.rs` (removal and moves with climbing), `query.rs` (selection queries and
 //! the front-to-back ray search), `pairs.rs` (node-vs-node self collision),
 //! `validate.rs`, `stats.rs`.
@@ -93,7 +94,7 @@ struct Loc {
 /// node's last object) plus freeing emptied ancestors. Depth is
 /// capped ([`DEFAULT_MAX_DEPTH`], or [`LooseKdTree::with_max_depth`]): at the cap a
 /// node takes every sphere routed to it, so zero-radius spheres on one point end up
-/// in one list rather than recursing forever (queries then scan that list).
+/// in one node rather than recursing forever (queries then scan that node).
 ///
 /// Spheres with `r >= R_max` are attached at the root: every query and the pair
 /// search test them directly, so many of them make the tree degrade towards brute

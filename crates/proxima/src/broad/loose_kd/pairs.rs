@@ -19,7 +19,11 @@
 //! The walks read each node's objects where they are stored, contiguously in the
 //! node (`Node::slots`); the carried sets are copies of the spheres with the
 //! object's node and position, so the inner loops scan flat arrays and only a
-//! reported pair goes back to the node for its handle and payload.
+//! reported pair goes back to the node for its handle and payload. A node whose
+//! own and carried objects are many (typically a node high in the tree holding
+//! big spheres spread over its box) sweeps them on its split axis instead of
+//! testing all pairs; the carried set is narrowed at each level except before a
+//! small leaf, where the copy would cost more than the tests it saves.
 
 use super::node::{FixedStack, Slot, NIL};
 use super::LooseKdTree;

@@ -132,7 +132,7 @@ impl<T> LooseKdTree<T> {
         }
         if items_seen != self.items.len() {
             return fail(format!(
-                "{items_seen} items in lists but {} stored",
+                "{items_seen} objects in nodes but {} stored",
                 self.items.len()
             ));
         }

@@ -4,7 +4,7 @@
 use crate::parry::ParryBvh;
 use crate::structure::{Indexed, Structure};
 use crate::workloads::Scene;
-use proxima::broad::BruteForce;
+use proxima::broad::{BruteForce, LinearOctree, LooseKdTree, OctreeConfig};
 
 /// One benchmarked structure: a name and how to make it empty for a scene.
 pub struct Entry {
@@ -54,8 +54,19 @@ macro_rules! proxima {
 pub fn entries() -> Vec<Entry> {
     vec![
         proxima!("BruteForce", true, |_: &Scene| BruteForce::<u32>::new()),
-        // One line per index, e.g.:
-        // proxima!("LooseKdTree", |s: &Scene| LooseKdTree::new(s.world, s.r_max, 0.5).unwrap()),
+        proxima!("LooseKdTree", |s: &Scene| LooseKdTree::new(
+            s.world, s.r_max, 0.25
+        )
+        .expect("loose k-d tree parameters")),
+        proxima!("LooseKdTree-d1", |s: &Scene| LooseKdTree::new(
+            s.world, s.r_max, 1.0
+        )
+        .expect("loose k-d tree parameters")),
+        proxima!("LinearOctree", |s: &Scene| LinearOctree::new(
+            s.world,
+            OctreeConfig::default()
+        )
+        .expect("octree parameters")),
         Entry {
             name: PARRY,
             quadratic: false,

@@ -1,4 +1,38 @@
-fn main() {
-    eprintln!("proxima: no command yet");
-    std::process::exit(2);
+//! `proxima`: the command-line tool of the Proxima library (design §4).
+//!
+//! This file only parses arguments and dispatches; each command lives in its own
+//! module, and the broad-phase indices they run are listed once in [`indices`].
+
+mod default_run;
+mod indices;
+mod replay;
+mod scene;
+mod trace;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Spatial queries and collision detection for dynamic 3D scenes.
+///
+/// Without a command: runs the default scene (moving spheres) through every
+/// broad-phase index and prints a comparison table.
+#[derive(Parser, Debug)]
+#[command(name = "proxima", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Replay a recorded scene trace against one index or all of them.
+    Replay(replay::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        None => default_run::main(),
+        Some(Command::Replay(args)) => replay::main(&args),
+    }
 }

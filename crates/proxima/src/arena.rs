@@ -168,6 +168,35 @@ impl<V> Arena<V> {
         }
     }
 
+    /// The live value in slot `index` with its current handle, or `None` for a
+    /// free or out-of-range slot. O(1). For structures that link their values by
+    /// slot number (intrusive lists) instead of by full handle.
+    #[inline]
+    pub fn get_by_index(&self, index: u32) -> Option<(Handle, &V)> {
+        let s = self.slots.get(index as usize)?;
+        match &s.entry {
+            Entry::Occupied(v) => Some((
+                Handle {
+                    tag: self.tag,
+                    index,
+                    generation: s.generation,
+                },
+                v,
+            )),
+            Entry::Vacant { .. } => None,
+        }
+    }
+
+    /// The live value in slot `index`, mutably, or `None` for a free or
+    /// out-of-range slot. O(1).
+    #[inline]
+    pub fn get_by_index_mut(&mut self, index: u32) -> Option<&mut V> {
+        match &mut self.slots.get_mut(index as usize)?.entry {
+            Entry::Occupied(v) => Some(v),
+            Entry::Vacant { .. } => None,
+        }
+    }
+
     /// Removes and returns the value of `h`; the slot's generation advances so `h`
     /// becomes stale. A slot whose generation would wrap is retired, never reused.
     pub fn remove(&mut self, h: Handle) -> Result<V> {
@@ -366,6 +395,18 @@ mod tests {
         a.validate().unwrap();
         b.insert(5);
         b.validate().unwrap();
+    }
+
+    #[test]
+    fn by_index_access() {
+        let mut a = Arena::new();
+        let h = a.insert(5);
+        assert_eq!(a.get_by_index(h.index()), Some((h, &5)));
+        *a.get_by_index_mut(h.index()).unwrap() = 6;
+        a.remove(h).unwrap();
+        assert!(a.get_by_index(h.index()).is_none());
+        assert!(a.get_by_index_mut(h.index()).is_none());
+        assert!(a.get_by_index(99).is_none());
     }
 
     #[test]

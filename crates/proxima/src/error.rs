@@ -25,11 +25,49 @@ pub enum Error {
     InvalidRayLength,
     /// A handle that was removed, belongs to another index, or predates `clear()`.
     StaleHandle,
+    /// A constructor parameter is out of its documented range (for example a
+    /// density outside `(0, 1]`).
+    InvalidParameter(String),
     /// A structure's invariant does not hold (from `validate()`).
     Invalid(String),
     /// A triangle mesh failed validation (no triangles, index out of range,
     /// non-finite vertex).
     InvalidMesh(String),
+    /// A mesh file could not be read (I/O failure, unknown format).
+    Io {
+        /// The file's path as given.
+        file: String,
+        /// What failed.
+        msg: String,
+    },
+    /// A mesh file is malformed: truncated, garbage, an index out of range, a
+    /// non-finite coordinate, a count that does not match the data…
+    Parse {
+        /// The file's path as given (or a caller-chosen name for in-memory data).
+        file: String,
+        /// Where: a line (text formats) or a byte offset (binary formats).
+        at: FileLocation,
+        /// What is wrong.
+        msg: String,
+    },
+}
+
+/// Where in a file a [`Error::Parse`] was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileLocation {
+    /// A 1-based line number of a text file.
+    Line(usize),
+    /// A 0-based byte offset into a binary file (or binary section).
+    Offset(u64),
+}
+
+impl fmt::Display for FileLocation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FileLocation::Line(n) => write!(f, "line {n}"),
+            FileLocation::Offset(o) => write!(f, "byte offset {o}"),
+        }
+    }
 }
 
 /// `Result` with [`Error`].
@@ -46,8 +84,11 @@ impl fmt::Display for Error {
             Error::StaleHandle => {
                 write!(f, "stale handle: removed, cleared, or from another index")
             }
+            Error::InvalidParameter(msg) => write!(f, "invalid parameter: {msg}"),
             Error::Invalid(msg) => write!(f, "invariant violated: {msg}"),
             Error::InvalidMesh(msg) => write!(f, "invalid mesh: {msg}"),
+            Error::Io { file, msg } => write!(f, "{file}: {msg}"),
+            Error::Parse { file, at, msg } => write!(f, "{file}: {at}: {msg}"),
         }
     }
 }

@@ -7,6 +7,8 @@
 //! - [`broad`]: the [`broad::SpatialIndex`] trait over bounding spheres and its
 //!   indices: [`broad::BruteForce`] (the oracle) and the loose k-d tree of the first
 //!   source document, with more to come.
+//! - [`narrow`]: triangle meshes and the exact, closed triangle–triangle test.
+//! - [`io`]: OBJ, STL and PLY loaders into a [`narrow::TriMesh`].
 //!
 //! Math types are [`glam`]'s (`f32`), re-exported as [`proxima::glam`](glam) so that
 //! users need not match versions by hand.
@@ -17,7 +19,8 @@ pub mod arena;
 pub mod broad;
 mod error;
 pub mod geom;
+pub mod io;
 pub mod narrow;
 
-pub use error::{Error, Result};
+pub use error::{Error, FileLocation, Result};
 pub use glam;

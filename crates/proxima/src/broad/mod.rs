@@ -3,6 +3,8 @@
 //! | index | idea | source |
 //! |---|---|---|
 //! | [`BruteForce`] | scan everything; the oracle | — |
+//! | [`LinearOctree`] | sparse octree named by location codes in a hash map; O(1) face-neighbour codes, moves via neighbours, split/merge with hysteresis, loose bounds by max extent | seed 004 |
+//! | [`LooseKdTree`] | binary tree with overlapping children (shared border zone); each sphere in exactly one node | seed 000 (`SPHERE_SET_TREE`) |
 //!
 //! Every index stores a [`Sphere`] and a user payload `T` per object and returns a
 //! generational [`Handle`]. Queries take `&self` (indices are `Send + Sync`, so
@@ -10,10 +12,14 @@
 //! early by returning [`ControlFlow::Break`].
 
 mod brute;
+pub mod loose_kd;
+pub mod octree;
 mod selection;
 
 pub use crate::arena::Handle;
 pub use brute::BruteForce;
+pub use loose_kd::LooseKdTree;
+pub use octree::{LinearOctree, OctreeConfig};
 pub use selection::Selection;
 
 use crate::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};

@@ -4,7 +4,7 @@
 mod harness;
 
 use harness::{run, SceneParams, ALL_SCENES};
-use proxima::broad::BruteForce;
+use proxima::broad::{BruteForce, LooseKdTree};
 
 /// Number of random operations per scene and seed.
 const OPS: usize = 6000;
@@ -25,3 +25,15 @@ macro_rules! oracle_suite {
 
 // The oracle against itself still exercises validate(), handles and bad input.
 oracle_suite!(brute_force, |_: &SceneParams| BruteForce::new());
+oracle_suite!(octree, |p: &SceneParams| {
+    let cfg = proxima::broad::OctreeConfig {
+        max_per_leaf: 4,
+        merge_below: 2,
+        max_depth: 12,
+    };
+    proxima::broad::LinearOctree::new(p.world, cfg).unwrap()
+});
+oracle_suite!(loose_kd, |p: &SceneParams| LooseKdTree::new(
+    p.world, p.r_max, 0.5
+)
+.unwrap());

@@ -1,0 +1,294 @@
+//! The loose k-d tree over bounding spheres of the first source document (the C++
+//! class `SPHERE_SET_TREE`: `Push`, `Pop`, `Move`, `Clear`, `TestIntersection`),
+//! design §2.1.
+//!
+//! Files, one concern each: `node.rs` (node layout, box derivation, conservative
+//! regions), `insert.rs` (the placement rule, node creation, item lists),
+//! `update.rs` (removal and moves with climbing), `query.rs` (selection queries and
+//! the front-to-back ray search), `pairs.rs` (node-vs-node self collision),
+//! `validate.rs`, `stats.rs`.
+
+mod insert;
+mod node;
+mod pairs;
+mod query;
+mod stats;
+mod update;
+mod validate;
+
+#[cfg(test)]
+mod tests;
+
+pub use stats::{KdStats, Placement};
+
+use crate::arena::{Arena, Handle, Pool};
+use crate::broad::{RayHit, Selection, SpatialIndex};
+use crate::geom::{Aabb, Ray, Sphere};
+use crate::{Error, Result};
+use node::{Node, NIL};
+use std::ops::ControlFlow;
+
+/// Largest accepted depth cap (it also sizes the fixed traversal stacks).
+pub const MAX_DEPTH_LIMIT: u8 = 64;
+
+/// Depth cap used by [`LooseKdTree::new`]: deep enough for worlds ~10⁶ times wider
+/// than the typical sphere, shallow enough that spheres of radius zero piled on one
+/// point stop after 40 levels instead of recursing until `f32` runs out of bits.
+pub const DEFAULT_MAX_DEPTH: u8 = 40;
+
+/// One stored object: the sphere, its node and its neighbours in the node's
+/// intrusive doubly linked list (arena slot numbers), and the payload.
+#[derive(Clone, Debug)]
+struct Item<T> {
+    sphere: Sphere,
+    node: u32,
+    prev: u32,
+    next: u32,
+    value: T,
+}
+
+/// The loose k-d tree of seed 000: a binary, unbalanced tree built lazily over a
+/// world box, whose two children overlap in a shared border zone so that every
+/// sphere lives in exactly one node (never duplicated, never split).
+///
+/// # Structure (design §2.1)
+///
+/// A node covers a box `B` and splits its longest axis `a` at the centre `m`, with
+/// border half-width `h = min(R_max, extent_a(B) · d / 4)` (`d` = density). The
+/// negative child covers `B` with `max_a = m + h`, the positive child `B` with
+/// `min_a = m - h`. A sphere with `r >= h` is attached to the node; a smaller one
+/// goes to the child on its centre's side (`c_a > m` → positive) and the rule
+/// repeats. Since such a sphere has `r < h`, it lies entirely on its side of the
+/// opposite child's border (`c_a - r > m - h`), so one comparison on the split axis
+/// decides whether a query can reach a child. Nodes are created on first use and
+/// freed when they hold nothing and have no children; the node count depends on the
+/// world box, `R_max`, `d` and where the spheres are, not on their number.
+///
+/// **Placement invariant.** At every moment, each sphere sits exactly in the node
+/// where inserting it afresh would put it (the tree is a function of the current
+/// set of spheres, not of their history). The seed's `Move` keeps a moved sphere in
+/// its node while it stays inside the node's box `B`; this implementation instead
+/// keeps it while the *placement rule* still routes it there (its centre is on the
+/// same side of every ancestor's centre plane, `r` is still below every ancestor's
+/// `h` and still `>= h` here). For a sphere inside the world this implies the
+/// seed's condition (a routed sphere lies inside `B`), so only the bookkeeping is
+/// stricter: pruning, [`LooseKdTree::validate`] and the oracle tests all rely on
+/// one exact invariant, and spheres outside the world box move as cheaply as
+/// inside ones (the seed's box test fails for them at every node, even the root).
+///
+/// # Costs
+///
+/// Memory: one node per occupied cell (`size_of` ≈ 88 bytes) plus one arena slot
+/// per object; both live in pooled arenas with free lists, so steady-state moves do
+/// not allocate. Insert and a move that leaves the node's cell are O(depth); a move
+/// inside the cell is O(1); removal is O(1) plus freeing emptied ancestors. Depth is
+/// capped ([`DEFAULT_MAX_DEPTH`], or [`LooseKdTree::with_max_depth`]): at the cap a
+/// node takes every sphere routed to it, so zero-radius spheres on one point end up
+/// in one list rather than recursing forever (queries then scan that list).
+///
+/// Spheres with `r >= R_max` are attached at the root: every query and the pair
+/// search test them directly, so many of them make the tree degrade towards brute
+/// force. Spheres outside the world box follow the same rule (the comparisons do
+/// not need the box) but they stretch the *regions* used for ray, frustum and pair
+/// pruning: the faces of node boxes that lie on the world boundary are replaced by
+/// the bounds of everything stored (kept until the tree is next empty or cleared),
+/// so far-away objects make boundary nodes look larger to those queries. Sphere
+/// and box queries, which prune with the split planes only, are unaffected.
+#[derive(Clone, Debug)]
+pub struct LooseKdTree<T> {
+    items: Arena<Item<T>>,
+    nodes: Pool<Node>,
+    root: u32,
+    world: Aabb,
+    r_max: f32,
+    density: f32,
+    max_depth: u8,
+    /// World box ∪ the bounding box of every sphere stored since the tree was last
+    /// empty: a bound for all stored spheres, used for the world-boundary faces of
+    /// node regions.
+    span: Aabb,
+    /// Absolute slack added outward to every pruning bound, so that a conservative
+    /// decision taken in `f32` can never disagree with the exact tests of
+    /// `geom::overlap` by a rounding error (see `node::Node::region`).
+    eps: f32,
+}
+
+impl<T> LooseKdTree<T> {
+    /// An empty tree over `world` for spheres up to radius `r_max`, with density
+    /// `density` in `(0, 1]` (higher: narrower border zones, deeper tree) and the
+    /// default depth cap. Errors on a non-finite or inverted world box, a
+    /// non-positive or non-finite `r_max`, or a density outside `(0, 1]`.
+    ///
+    /// Objects outside `world` or larger than `r_max` are still accepted and
+    /// answered exactly; see the type's docs for what they cost.
+    pub fn new(world: Aabb, r_max: f32, density: f32) -> Result<Self> {
+        Self::with_max_depth(world, r_max, density, DEFAULT_MAX_DEPTH)
+    }
+
+    /// As [`LooseKdTree::new`] with an explicit depth cap `1..=`[`MAX_DEPTH_LIMIT`]
+    /// (the root is depth 0).
+    pub fn with_max_depth(world: Aabb, r_max: f32, density: f32, max_depth: u8) -> Result<Self> {
+        world.validate()?;
+        if !r_max.is_finite() || r_max <= 0.0 {
+            return Err(Error::InvalidParameter(format!(
+                "r_max must be finite and > 0, got {r_max}"
+            )));
+        }
+        if !(density > 0.0 && density <= 1.0) {
+            return Err(Error::InvalidParameter(format!(
+                "density must be in (0, 1], got {density}"
+            )));
+        }
+        if max_depth == 0 || max_depth > MAX_DEPTH_LIMIT {
+            return Err(Error::InvalidParameter(format!(
+                "max_depth must be in 1..={MAX_DEPTH_LIMIT}, got {max_depth}"
+            )));
+        }
+        let mut t = LooseKdTree {
+            items: Arena::new(),
+            nodes: Pool::default(),
+            root: NIL,
+            world,
+            r_max,
+            density,
+            max_depth,
+            span: world,
+            eps: 0.0,
+        };
+        t.eps = node::slack(&t.span);
+        Ok(t)
+    }
+
+    /// The world box the tree subdivides.
+    pub fn world(&self) -> Aabb {
+        self.world
+    }
+
+    /// The `R_max` parameter.
+    pub fn r_max(&self) -> f32 {
+        self.r_max
+    }
+
+    /// The density parameter.
+    pub fn density(&self) -> f32 {
+        self.density
+    }
+
+    /// The depth cap (root = 0).
+    pub fn max_depth(&self) -> u8 {
+        self.max_depth
+    }
+
+    /// Grows `span` (and the slack) to cover `s`. O(1).
+    #[inline]
+    fn cover(&mut self, s: &Sphere) {
+        let b = s.aabb();
+        if !self.span.contains_aabb(&b) {
+            self.span = self.span.union(&b);
+            self.eps = node::slack(&self.span);
+        }
+    }
+
+    /// Forgets the bounds of removed objects once nothing is stored.
+    fn reset_span_if_empty(&mut self) {
+        if self.items.is_empty() {
+            self.span = self.world;
+            self.eps = node::slack(&self.span);
+        }
+    }
+}
+
+impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
+    /// Seed `Push`: O(depth), creating the missing nodes on the way.
+    fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+        sphere.validate()?;
+        self.cover(&sphere);
+        let root = self.ensure_root();
+        let node = self.descend(root, &sphere);
+        let h = self.items.insert(Item {
+            sphere,
+            node: NIL,
+            prev: NIL,
+            next: NIL,
+            value,
+        });
+        self.link(node, h.index());
+        Ok(h)
+    }
+
+    /// Seed `Pop`: O(1) unlink, then frees emptied nodes upwards.
+    fn remove(&mut self, handle: Handle) -> Result<T> {
+        self.items.get(handle)?;
+        let node = self.unlink(handle.index());
+        self.prune_up(node);
+        let item = self.items.remove(handle)?;
+        self.reset_span_if_empty();
+        Ok(item.value)
+    }
+
+    /// Seed `Move`; see the type's docs for when the object changes node.
+    fn update(&mut self, handle: Handle, sphere: Sphere) -> Result<()> {
+        sphere.validate()?;
+        self.items.get(handle)?;
+        self.cover(&sphere);
+        self.move_item(handle.index(), sphere);
+        Ok(())
+    }
+
+    fn get(&self, handle: Handle) -> Result<(Sphere, &T)> {
+        self.items.get(handle).map(|it| (it.sphere, &it.value))
+    }
+
+    fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
+        self.items.get_mut(handle).map(|it| &mut it.value)
+    }
+
+    fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// Seed `Clear`: drops every node and object and releases the memory.
+    fn clear(&mut self) {
+        self.items.clear();
+        self.nodes.clear();
+        self.root = NIL;
+        self.span = self.world;
+        self.eps = node::slack(&self.span);
+    }
+
+    fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
+        for (h, it) in self.items.iter() {
+            f(h, &it.sphere, &it.value);
+        }
+    }
+
+    fn visit<Q: Selection + ?Sized>(
+        &self,
+        query: &Q,
+        f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        self.visit_impl(query, f)
+    }
+
+    fn for_each_pair(
+        &self,
+        f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        self.pairs_impl(f)
+    }
+
+    /// Front-to-back: nearer child first, subtrees whose region the ray enters
+    /// after the best hit so far are skipped.
+    fn ray_first_unchecked(&self, ray: &Ray) -> Option<RayHit> {
+        self.ray_first_impl(ray)
+    }
+
+    fn validate(&self) -> Result<()> {
+        self.validate_impl()
+    }
+
+    /// The struct plus the capacity of the item arena and the node pool.
+    fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>() + self.items.heap_bytes() + self.nodes.heap_bytes()
+    }
+}

@@ -1,0 +1,192 @@
+//! Node layout, the derivation of child boxes from their parent, the conservative
+//! region of a subtree, and a fixed-size traversal stack.
+
+use super::LooseKdTree;
+use crate::geom::{Aabb, Sphere};
+use glam::Vec3;
+
+/// "No node / no item".
+pub(super) const NIL: u32 = u32::MAX;
+
+/// A tree node (seed `NODE`), flat in a [`Pool`](crate::arena::Pool).
+#[derive(Clone, Debug)]
+pub(super) struct Node {
+    /// The seed's box `B`: the world box, narrowed by one face per split above.
+    pub bbox: Aabb,
+    /// Where the centres of spheres routed through this node lie: per split above,
+    /// `c_a > m` (positive side, `cell.min` exclusive) or `c_a <= m` (negative side,
+    /// `cell.max` inclusive). Unsplit faces are infinite: the rule ignores the
+    /// world box. Lets a move check in O(1) that the placement is unchanged.
+    pub cell: Aabb,
+    /// Centre of `bbox` on the split axis.
+    pub m: f32,
+    /// Border half-width `min(R_max, extent_axis(bbox) · d / 4)`.
+    pub h: f32,
+    /// The parent's `h` (∞ at the root): a sphere is routed here only if `r < h_up`.
+    /// `h` never grows downwards, so this is the smallest `h` on the path.
+    pub h_up: f32,
+    pub parent: u32,
+    /// `[negative, positive]`.
+    pub child: [u32; 2],
+    /// Head of the intrusive item list (arena slot numbers).
+    pub first: u32,
+    /// Items attached here.
+    pub count: u32,
+    /// Split axis: the longest of `bbox` (ties to the lower index, as in the seed).
+    pub axis: u8,
+    pub depth: u8,
+}
+
+impl Node {
+    /// A node over `bbox`; split axis, `m` and `h` are derived from it.
+    pub fn new(
+        bbox: Aabb,
+        cell: Aabb,
+        h_up: f32,
+        parent: u32,
+        depth: u8,
+        r_max: f32,
+        density: f32,
+    ) -> Node {
+        let (axis, m, h) = split_of(&bbox, r_max, density);
+        Node {
+            bbox,
+            cell,
+            m,
+            h,
+            h_up,
+            parent,
+            child: [NIL, NIL],
+            first: NIL,
+            count: 0,
+            axis,
+            depth,
+        }
+    }
+
+    /// Box and cell of the child on `side` (0 negative, 1 positive): the seed's
+    /// `B2.Max[a] -= UnusedSpace` / `B2.Min[a] += UnusedSpace`, written as
+    /// `m + h` / `m - h` directly.
+    pub fn child_bounds(&self, side: usize) -> (Aabb, Aabb) {
+        let a = self.axis as usize;
+        let (mut b, mut c) = (self.bbox, self.cell);
+        // The cell is intersected, not overwritten: `m` is the centre of the loose
+        // box, which need not lie inside this node's (tighter) cell.
+        if side == 1 {
+            b.min[a] = self.m - self.h;
+            c.min[a] = c.min[a].max(self.m);
+        } else {
+            b.max[a] = self.m + self.h;
+            c.max[a] = c.max[a].min(self.m);
+        }
+        (b, c)
+    }
+
+    /// True when the node holds no item and has no child (it must then be freed).
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.first == NIL && self.child[0] == NIL && self.child[1] == NIL
+    }
+
+    /// True if the placement rule routes `s` through this node: its centre is on
+    /// this node's side of every split above, and `r` is below every `h` above.
+    #[inline]
+    pub fn routes(&self, s: &Sphere) -> bool {
+        s.radius < self.h_up
+            && s.center.cmpgt(self.cell.min).all()
+            && s.center.cmple(self.cell.max).all()
+    }
+}
+
+/// Split axis, centre and border half-width of a node box (seed `RecursivePush`,
+/// steps 1 and 3). `m` is computed as `min/2 + max/2` so huge boxes do not overflow.
+pub(super) fn split_of(b: &Aabb, r_max: f32, density: f32) -> (u8, f32, f32) {
+    let axis = b.longest_axis();
+    let (lo, hi) = (b.min[axis], b.max[axis]);
+    let m = lo * 0.5 + hi * 0.5;
+    let h = r_max.min((hi - lo) * density * 0.25);
+    (axis as u8, m, h)
+}
+
+/// Slack for pruning bounds: about 80 ulps of the largest coordinate stored.
+pub(super) fn slack(span: &Aabb) -> f32 {
+    let mag = span.min.abs().max(span.max.abs()).max_element();
+    (mag * 1e-5).max(f32::MIN_POSITIVE)
+}
+
+/// The cell of the root: every centre.
+pub(super) fn all_space() -> Aabb {
+    Aabb::new(Vec3::splat(f32::NEG_INFINITY), Vec3::splat(f32::INFINITY))
+}
+
+impl<T> LooseKdTree<T> {
+    /// A box containing every sphere stored in the subtree of `n`, with `eps` to
+    /// spare on every side. Used by frustum, ray and pair pruning.
+    ///
+    /// Why it is conservative: a face of `bbox` that comes from a split above is
+    /// `m - h` (positive side) or `m + h` (negative side) of that split, and every
+    /// sphere routed through it has `c_a > m` and `r < h` (or `c_a <= m`, `r < h`),
+    /// so it lies strictly on the inner side of that face — whether or not it is
+    /// inside the world box. A face of `bbox` that equals the world box's face was
+    /// never split (split faces lie strictly inside the world) and bounds nothing
+    /// for spheres outside the world, so it is replaced by the face of `span`, which
+    /// covers every stored sphere. (If rounding ever made a split face equal the
+    /// world face, using `span` there is merely looser.) The outward `eps` absorbs
+    /// rounding in the callers' `f32` tests, so pruning never disagrees with the
+    /// exact tests of `geom::overlap` on a sphere that touches a face.
+    #[inline]
+    pub(super) fn region(&self, n: &Node) -> Aabb {
+        let e = Vec3::splat(self.eps);
+        let min = Vec3::select(n.bbox.min.cmpeq(self.world.min), self.span.min, n.bbox.min);
+        let max = Vec3::select(n.bbox.max.cmpeq(self.world.max), self.span.max, n.bbox.max);
+        Aabb::new(min - e, max + e)
+    }
+
+    /// Lower bound on the split axis of every sphere in the positive subtree of `n`
+    /// (`c_a - r > m - h`), minus slack.
+    #[inline]
+    pub(super) fn pos_floor(&self, n: &Node) -> f32 {
+        n.m - n.h - self.eps
+    }
+
+    /// Upper bound on the split axis of every sphere in the negative subtree of `n`
+    /// (`c_a + r < m + h`), plus slack.
+    #[inline]
+    pub(super) fn neg_ceil(&self, n: &Node) -> f32 {
+        n.m + n.h + self.eps
+    }
+}
+
+/// Capacity of [`FixedStack`]. A depth-first walk that pops a node and pushes at
+/// most its two children holds at most one pending sibling per level plus two, so
+/// `MAX_DEPTH_LIMIT + 2` entries suffice; the rest is margin.
+const STACK: usize = super::MAX_DEPTH_LIMIT as usize + 8;
+
+/// A traversal stack on the call stack: queries allocate nothing.
+pub(super) struct FixedStack<E: Copy + Default> {
+    buf: [E; STACK],
+    len: usize,
+}
+
+impl<E: Copy + Default> FixedStack<E> {
+    pub fn new() -> Self {
+        FixedStack {
+            buf: [E::default(); STACK],
+            len: 0,
+        }
+    }
+    #[inline]
+    pub fn push(&mut self, e: E) {
+        self.buf[self.len] = e;
+        self.len += 1;
+    }
+    #[inline]
+    pub fn pop(&mut self) -> Option<E> {
+        if self.len == 0 {
+            None
+        } else {
+            self.len -= 1;
+            Some(self.buf[self.len])
+        }
+    }
+}

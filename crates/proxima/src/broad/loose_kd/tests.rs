@@ -1,0 +1,289 @@
+//! Unit tests of the loose k-d tree (the randomized oracle suite lives in
+//! `tests/oracle` and `tests/loose_kd.rs`).
+
+use super::*;
+use crate::broad::BruteForce;
+use glam::{vec3, Vec3};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+fn cube(side: f32) -> Aabb {
+    Aabb::new(Vec3::ZERO, Vec3::splat(side))
+}
+
+/// The seed's `RecursivePush`, re-derived on boxes alone (independently of the
+/// tree's code): the depth and box where a sphere must sit.
+fn seed_placement(world: Aabb, r_max: f32, d: f32, cap: usize, s: &Sphere) -> (usize, Aabb) {
+    let mut b = world;
+    let mut depth = 0;
+    loop {
+        let size = b.max - b.min;
+        let mut a = 0;
+        for i in 1..3 {
+            if size[i] > size[a] {
+                a = i;
+            }
+        }
+        let ext = b.max[a] - b.min[a];
+        let half = r_max.min(ext * d * 0.25);
+        if s.radius >= half || depth == cap {
+            return (depth, b);
+        }
+        let mid = b.min[a] * 0.5 + b.max[a] * 0.5;
+        if s.center[a] > mid {
+            b.min[a] = mid - half;
+        } else {
+            b.max[a] = mid + half;
+        }
+        depth += 1;
+    }
+}
+
+#[test]
+fn bad_parameters_are_rejected() {
+    let w = cube(10.0);
+    assert!(LooseKdTree::<()>::new(w, 1.0, 0.5).is_ok());
+    assert!(LooseKdTree::<()>::new(w, 0.0, 0.5).is_err());
+    assert!(LooseKdTree::<()>::new(w, -1.0, 0.5).is_err());
+    assert!(LooseKdTree::<()>::new(w, f32::NAN, 0.5).is_err());
+    assert!(LooseKdTree::<()>::new(w, f32::INFINITY, 0.5).is_err());
+    assert!(LooseKdTree::<()>::new(w, 1.0, 0.0).is_err());
+    assert!(LooseKdTree::<()>::new(w, 1.0, 1.0001).is_err());
+    assert!(LooseKdTree::<()>::new(w, 1.0, f32::NAN).is_err());
+    assert!(LooseKdTree::<()>::new(w, 1.0, 1.0).is_ok());
+    let inverted = Aabb::new(Vec3::ONE, Vec3::ZERO);
+    assert!(LooseKdTree::<()>::new(inverted, 1.0, 0.5).is_err());
+    assert!(LooseKdTree::<()>::new(Aabb::new(Vec3::ZERO, Vec3::INFINITY), 1.0, 0.5).is_err());
+    assert!(LooseKdTree::<()>::with_max_depth(w, 1.0, 0.5, 0).is_err());
+    assert!(LooseKdTree::<()>::with_max_depth(w, 1.0, 0.5, MAX_DEPTH_LIMIT + 1).is_err());
+    assert!(LooseKdTree::<()>::with_max_depth(w, 1.0, 0.5, MAX_DEPTH_LIMIT).is_ok());
+}
+
+#[test]
+fn crafted_spheres_land_where_the_seed_puts_them() {
+    // World 16 x 8 x 8, d = 1, R_max large: root splits x at m = 8 with h = 4.
+    let world = Aabb::new(Vec3::ZERO, vec3(16.0, 8.0, 8.0));
+    let mut t = LooseKdTree::new(world, 100.0, 1.0).unwrap();
+    let at = |t: &LooseKdTree<u32>, h| {
+        let p = t.placement(h).unwrap();
+        (p.depth, p.node_box)
+    };
+    // r >= h = 4: attached to the root.
+    let a = t.insert(Sphere::new(vec3(9.0, 1.0, 1.0), 4.0), 0).unwrap();
+    assert_eq!(at(&t, a), (0, world));
+    // r < 4, c_x = 9 > 8: positive child [4, 16] (m = 10, h = 3); 3.9 >= 3 stops.
+    let b = t.insert(Sphere::new(vec3(9.0, 1.0, 1.0), 3.9), 1).unwrap();
+    let pos = Aabb::new(vec3(4.0, 0.0, 0.0), vec3(16.0, 8.0, 8.0));
+    assert_eq!(at(&t, b), (1, pos));
+    // c_x == m goes negative: [0, 12].
+    let c = t.insert(Sphere::new(vec3(8.0, 1.0, 1.0), 3.9), 2).unwrap();
+    let neg = Aabb::new(Vec3::ZERO, vec3(12.0, 8.0, 8.0));
+    assert_eq!(at(&t, c), (1, neg));
+    // r = 2.9 < 3 descends again: c_x = 9 <= 10 → [4, 13] (m = 8.5, h = 2.25).
+    let d = t.insert(Sphere::new(vec3(9.0, 1.0, 1.0), 2.9), 3).unwrap();
+    let deeper = Aabb::new(vec3(4.0, 0.0, 0.0), vec3(13.0, 8.0, 8.0));
+    assert_eq!(at(&t, d), (2, deeper));
+    // Far outside the world box: the rule only compares on split axes.
+    let e = t
+        .insert(Sphere::new(vec3(9.0, -50.0, 1000.0), 2.9), 4)
+        .unwrap();
+    assert_eq!(at(&t, e), (2, deeper));
+    // Larger than R_max: root.
+    let f = t
+        .insert(Sphere::new(vec3(1.0, 1.0, 1.0), 500.0), 5)
+        .unwrap();
+    assert_eq!(at(&t, f), (0, world));
+    // Moving d across the root's split sends it to the negative side.
+    t.update(d, Sphere::new(vec3(7.0, 1.0, 1.0), 2.9)).unwrap();
+    let s = t.get(d).unwrap().0;
+    assert_eq!(at(&t, d), seed_placement(world, 100.0, 1.0, 40, &s));
+    assert_eq!(at(&t, d).0, 2);
+    // Shrinking b below its node's h sends it deeper.
+    t.update(b, Sphere::new(vec3(9.0, 1.0, 1.0), 1.0)).unwrap();
+    assert!(at(&t, b).0 > 1);
+    t.validate().unwrap();
+    assert_eq!(t.stats().items_per_depth.iter().sum::<usize>(), 6);
+}
+
+/// Random inserts, moves (small, long, resizes, out of the world) and removals:
+/// after every step each object sits exactly where the seed's rule puts it.
+#[test]
+fn placement_invariant_over_random_history() {
+    for (d, cap) in [(0.5, 40u8), (0.1, 40), (1.0, 6)] {
+        let world = Aabb::new(vec3(-50.0, 0.0, 0.0), vec3(50.0, 60.0, 20.0));
+        let mut t = LooseKdTree::with_max_depth(world, 2.0, d, cap).unwrap();
+        let mut rng = Pcg64::seed_from_u64(7);
+        let mut live = Vec::new();
+        let sphere = |rng: &mut Pcg64| {
+            let c = vec3(
+                rng.gen_range(-70.0..70.0),
+                rng.gen_range(-10.0..70.0),
+                rng.gen_range(-5.0..25.0),
+            );
+            let r = match rng.gen_range(0..10) {
+                0 => 0.0,
+                1 => rng.gen_range(2.0..30.0),
+                _ => rng.gen_range(0.0..2.0),
+            };
+            Sphere::new(c, r)
+        };
+        for step in 0..4000 {
+            match rng.gen_range(0..10) {
+                0..=3 => live.push(t.insert(sphere(&mut rng), step).unwrap()),
+                4..=7 if !live.is_empty() => {
+                    let h = live[rng.gen_range(0..live.len())];
+                    let old = t.get(h).unwrap().0;
+                    let s = if rng.gen_bool(0.7) {
+                        Sphere::new(
+                            old.center + Vec3::splat(rng.gen_range(-1.0..1.0)),
+                            old.radius,
+                        )
+                    } else {
+                        sphere(&mut rng)
+                    };
+                    t.update(h, s).unwrap();
+                }
+                _ if !live.is_empty() => {
+                    let h = live.swap_remove(rng.gen_range(0..live.len()));
+                    t.remove(h).unwrap();
+                }
+                _ => {}
+            }
+            if step % 50 == 0 {
+                t.validate().unwrap();
+                for &h in &live {
+                    let s = t.get(h).unwrap().0;
+                    let p = t.placement(h).unwrap();
+                    let want = seed_placement(world, 2.0, d, cap as usize, &s);
+                    assert_eq!((p.depth, p.node_box), want, "d {d} step {step} {s:?}");
+                }
+            }
+        }
+    }
+}
+
+/// Because moves keep the placement rule exact, the tree depends only on the
+/// current spheres: moving objects gives the same shape as inserting them fresh.
+#[test]
+fn shape_is_independent_of_history() {
+    let world = cube(100.0);
+    let mut rng = Pcg64::seed_from_u64(3);
+    let mut moved = LooseKdTree::new(world, 2.0, 0.5).unwrap();
+    let mut hs = Vec::new();
+    for i in 0..2000 {
+        let c = vec3(
+            rng.gen_range(0.0..100.0),
+            rng.gen_range(0.0..100.0),
+            rng.gen_range(0.0..100.0),
+        );
+        hs.push(
+            moved
+                .insert(Sphere::new(c, rng.gen_range(0.5..2.0)), i)
+                .unwrap(),
+        );
+    }
+    for _ in 0..5 {
+        for &h in &hs {
+            let s = moved.get(h).unwrap().0;
+            let step = vec3(
+                rng.gen_range(-3.0..3.0),
+                rng.gen_range(-3.0..3.0),
+                rng.gen_range(-3.0..3.0),
+            );
+            moved
+                .update(h, Sphere::new(s.center + step, s.radius))
+                .unwrap();
+        }
+    }
+    let mut fresh = LooseKdTree::new(world, 2.0, 0.5).unwrap();
+    moved.for_each(|_, s, v| {
+        fresh.insert(*s, *v).unwrap();
+    });
+    moved.validate().unwrap();
+    fresh.validate().unwrap();
+    assert_eq!(moved.stats(), fresh.stats());
+}
+
+#[test]
+fn depth_cap_holds_100k_points_on_one_point() {
+    let mut t = LooseKdTree::new(cube(100.0), 2.0, 0.5).unwrap();
+    let p = vec3(37.5, 12.25, 80.0);
+    let hs: Vec<_> = (0..100_000)
+        .map(|i| t.insert(Sphere::new(p, 0.0), i).unwrap())
+        .collect();
+    t.validate().unwrap();
+    let st = t.stats();
+    assert_eq!(st.max_depth, DEFAULT_MAX_DEPTH as usize);
+    assert_eq!(st.nodes, DEFAULT_MAX_DEPTH as usize + 1, "one path");
+    assert_eq!(st.max_items_per_node, 100_000);
+    assert_eq!(t.within(p, 0.0).unwrap().len(), 100_000);
+    assert!(t.within(p + Vec3::X, 0.5).unwrap().is_empty());
+    // Moving within the capped cell is O(1) and keeps the structure.
+    t.update(hs[0], Sphere::new(p + Vec3::splat(1e-6), 0.0))
+        .unwrap();
+    for h in hs {
+        t.remove(h).unwrap();
+    }
+    t.validate().unwrap();
+    assert_eq!(t.stats(), KdStats::default());
+}
+
+#[test]
+fn ray_first_ties_go_to_the_smallest_handle() {
+    let mut t = LooseKdTree::new(cube(100.0), 2.0, 0.5).unwrap();
+    let mut b = BruteForce::new();
+    let s = Sphere::new(vec3(50.0, 50.0, 50.0), 1.0);
+    let mut hs = Vec::new();
+    for i in 0..5 {
+        // Same sphere, scattered insertion order around other objects.
+        t.insert(Sphere::new(vec3(10.0 * i as f32, 5.0, 5.0), 1.0), 100)
+            .unwrap();
+        hs.push(t.insert(s, i).unwrap());
+        b.insert(s, i).unwrap();
+    }
+    let ray = Ray::new(vec3(0.0, 50.0, 50.0), Vec3::X);
+    let hit = t.ray_first(&ray).unwrap().unwrap();
+    assert_eq!(hit.t, 49.0);
+    assert_eq!(hit.handle, *hs.iter().min().unwrap());
+    assert_eq!(b.ray_first(&ray).unwrap().unwrap().t, 49.0);
+}
+
+#[test]
+fn memory_is_pooled_and_released_by_clear() {
+    let mut t = LooseKdTree::new(cube(100.0), 2.0, 0.5).unwrap();
+    let empty = t.memory_bytes();
+    let mut rng = Pcg64::seed_from_u64(9);
+    let hs: Vec<_> = (0..1000)
+        .map(|i| {
+            let c = Vec3::splat(rng.gen_range(0.0..100.0));
+            t.insert(Sphere::new(c, 1.0), i).unwrap()
+        })
+        .collect();
+    let full = t.memory_bytes();
+    assert!(full > empty + 1000 * std::mem::size_of::<Sphere>());
+    for h in hs {
+        t.remove(h).unwrap();
+    }
+    // Pools keep their capacity for reuse (the node free list even grows)...
+    assert!(t.memory_bytes() >= full);
+    // ...until clear releases it.
+    t.clear();
+    assert_eq!(t.memory_bytes(), empty);
+    t.validate().unwrap();
+}
+
+#[test]
+fn stale_handles_and_bad_spheres_change_nothing() {
+    let mut t = LooseKdTree::new(cube(10.0), 1.0, 0.5).unwrap();
+    let h = t.insert(Sphere::new(Vec3::ONE, 0.5), 1).unwrap();
+    let before = t.stats();
+    assert!(t.update(h, Sphere::new(Vec3::NAN, 0.5)).is_err());
+    assert!(t.update(h, Sphere::new(Vec3::ONE, -0.5)).is_err());
+    assert!(t.insert(Sphere::new(Vec3::ONE, f32::INFINITY), 2).is_err());
+    assert_eq!(t.stats(), before);
+    assert_eq!(t.remove(h), Ok(1));
+    assert!(t.remove(h).is_err());
+    assert!(t.update(h, Sphere::new(Vec3::ONE, 0.5)).is_err());
+    assert!(t.placement(h).is_err());
+    t.validate().unwrap();
+}

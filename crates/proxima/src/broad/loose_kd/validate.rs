@@ -1,0 +1,146 @@
+//! `validate()`: every structural invariant, checked from scratch.
+
+use super::node::{all_space, slack, split_of, NIL};
+use super::LooseKdTree;
+use crate::{Error, Result};
+
+fn fail(msg: String) -> Result<()> {
+    Err(Error::Invalid(msg))
+}
+
+impl<T> LooseKdTree<T> {
+    /// Checks: arena and pool free lists; parent/child links; each node's box,
+    /// cell, split axis, `m`, `h` and `h_up` re-derived from its parent (the root's
+    /// from the world box); `h` never growing downwards; the depth cap; no empty
+    /// node; every item list's links, owner and count; every item placed exactly
+    /// where the placement rule puts it; `span` covering the world and every
+    /// sphere. O(nodes + items).
+    pub(super) fn validate_impl(&self) -> Result<()> {
+        self.items.validate()?;
+        let slots = self.nodes.slot_count();
+        let mut free = vec![false; slots];
+        for &i in self.nodes.free_slots() {
+            let Some(seen) = free.get_mut(i as usize) else {
+                return fail(format!("free node slot {i} out of range"));
+            };
+            if *seen {
+                return fail(format!("node slot {i} freed twice"));
+            }
+            *seen = true;
+        }
+        if !self.span.contains_aabb(&self.world) || self.eps != slack(&self.span) {
+            return fail("span does not cover the world or eps is stale".into());
+        }
+        if self.root == NIL {
+            if !self.nodes.is_empty() || !self.items.is_empty() {
+                return fail("no root but live nodes or items".into());
+            }
+            return Ok(());
+        }
+        let mut reached = 0usize;
+        let mut items_seen = 0usize;
+        let mut stack = vec![self.root];
+        while let Some(n) = stack.pop() {
+            if (n as usize) >= slots || free[n as usize] {
+                return fail(format!("node {n} is free or out of range but linked"));
+            }
+            reached += 1;
+            if reached > self.nodes.len() {
+                return fail("cycle in the node links".into());
+            }
+            let node = &self.nodes[n];
+            // Derivation from the parent (or the world box for the root).
+            let (bbox, cell, h_up, depth) = if n == self.root {
+                if node.parent != NIL {
+                    return fail("root has a parent".into());
+                }
+                (self.world, all_space(), f32::INFINITY, 0u8)
+            } else {
+                let p = &self.nodes[node.parent];
+                let side = match p.child {
+                    [a, _] if a == n => 0,
+                    [_, b] if b == n => 1,
+                    _ => return fail(format!("node {n} is not a child of its parent")),
+                };
+                let (b, c) = p.child_bounds(side);
+                (b, c, p.h, p.depth + 1)
+            };
+            let (axis, m, h) = split_of(&bbox, self.r_max, self.density);
+            if node.bbox != bbox
+                || node.cell != cell
+                || node.h_up != h_up
+                || node.depth != depth
+                || (node.axis, node.m, node.h) != (axis, m, h)
+            {
+                return fail(format!(
+                    "node {n}: box, cell or split not derived from parent"
+                ));
+            }
+            if node.h > node.h_up {
+                return fail(format!("node {n}: h grows downwards"));
+            }
+            if node.depth > self.max_depth
+                || (node.depth == self.max_depth && node.child != [NIL, NIL])
+            {
+                return fail(format!("node {n}: depth cap exceeded"));
+            }
+            if node.is_empty() {
+                return fail(format!("node {n}: empty node not freed"));
+            }
+            // Item list.
+            let mut count = 0u32;
+            let mut prev = NIL;
+            let mut it = node.first;
+            while it != NIL {
+                let Some((_, item)) = self.items.get_by_index(it) else {
+                    return fail(format!("node {n} lists dead item slot {it}"));
+                };
+                if item.node != n || item.prev != prev {
+                    return fail(format!("item slot {it}: owner or prev link wrong"));
+                }
+                count += 1;
+                if count > node.count {
+                    return fail(format!("node {n}: list longer than its count"));
+                }
+                let s = &item.sphere;
+                let here = s.radius >= node.h || node.depth >= self.max_depth;
+                if !node.routes(s) || !here {
+                    return fail(format!(
+                        "item slot {it} at node {n} (depth {}) breaks the placement rule",
+                        node.depth
+                    ));
+                }
+                if !self.span.contains_aabb(&s.aabb()) {
+                    return fail(format!("item slot {it} outside span"));
+                }
+                prev = it;
+                it = item.next;
+            }
+            if count != node.count {
+                return fail(format!("node {n}: count {} but {count} listed", node.count));
+            }
+            items_seen += count as usize;
+            for c in node.child {
+                if c != NIL {
+                    if (c as usize) >= slots || free[c as usize] || self.nodes[c].parent != n {
+                        return fail(format!("node {n}: child {c} bad or not linked back"));
+                    }
+                    stack.push(c);
+                }
+            }
+        }
+        if reached != self.nodes.len() {
+            return fail(format!(
+                "{reached} nodes reachable but {} live",
+                self.nodes.len()
+            ));
+        }
+        if items_seen != self.items.len() {
+            return fail(format!(
+                "{items_seen} items in lists but {} stored",
+                self.items.len()
+            ));
+        }
+        Ok(())
+    }
+}

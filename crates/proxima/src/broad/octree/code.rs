@@ -1,0 +1,494 @@
+//! Location codes: the names of octree cells (seed 004, §2; design §2.2).
+//!
+//! A code is a `u64` holding a leading sentinel 1 bit followed by 3 bits per level,
+//! from the root down: bit 0 of each triple is the x half (0 = low, 1 = high), bit 1
+//! the y half, bit 2 the z half. It is a Morton (Z-order) code that also encodes its
+//! depth: the sentinel sits at bit `3 * depth`. The root is `1`; depth 21 uses all
+//! 64 bits. The seed writes the same thing as octal digits `q1 q2 … qn`.
+//!
+//! Because the x bits of all levels sit at positions `0, 3, 6, …` ("dilated"
+//! integers), adding or subtracting one cell along an axis is one integer addition
+//! with masks: fill the other axes' bits with ones so the carry jumps over them
+//! (`+1`), or let the borrow run through them and mask it away (`-1`). That is the
+//! seed's octal rule ("add 4 to the trailing digits of the upper set, subtract 4
+//! from the first one that is not") done for all levels at once, in O(1), with no
+//! loop over the levels.
+
+use crate::geom::Aabb;
+use glam::Vec3;
+
+/// Deepest level a `u64` code can name: 1 sentinel bit + 3 × 21 = 64 bits.
+pub const MAX_DEPTH: u32 = 21;
+
+/// The x bits of every level (positions 0, 3, …, 60); y and z are this shifted by 1
+/// and 2.
+const X_BITS: u64 = 0x1249_2492_4924_9249;
+
+/// One of the six faces of a cell, naming the direction of a face neighbour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Face {
+    /// Towards −x.
+    NegX,
+    /// Towards +x.
+    PosX,
+    /// Towards −y.
+    NegY,
+    /// Towards +y.
+    PosY,
+    /// Towards −z.
+    NegZ,
+    /// Towards +z.
+    PosZ,
+}
+
+impl Face {
+    /// All six faces, in the order −x, +x, −y, +y, −z, +z.
+    pub const ALL: [Face; 6] = [
+        Face::NegX,
+        Face::PosX,
+        Face::NegY,
+        Face::PosY,
+        Face::NegZ,
+        Face::PosZ,
+    ];
+
+    /// The face along `axis` (0 = x, 1 = y, 2 = z) on the positive or negative side.
+    /// `axis` is taken modulo 3.
+    #[inline]
+    pub fn new(axis: usize, positive: bool) -> Face {
+        Face::ALL[(axis % 3) * 2 + positive as usize]
+    }
+
+    /// The axis the face is normal to (0 = x, 1 = y, 2 = z).
+    #[inline]
+    pub fn axis(self) -> usize {
+        self as usize / 2
+    }
+
+    /// True for +x, +y, +z.
+    #[inline]
+    pub fn is_positive(self) -> bool {
+        self as usize % 2 == 1
+    }
+
+    /// The face on the other side of the cell.
+    #[inline]
+    pub fn opposite(self) -> Face {
+        Face::new(self.axis(), !self.is_positive())
+    }
+}
+
+/// The name of an octree cell: sentinel bit + 3 bits (x, y, z) per level (see the
+/// module docs). All operations are O(1) bit arithmetic.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct LocationCode(u64);
+
+/// Spreads the low 21 bits of `v` to every third bit (Morton encoding of one axis).
+#[inline]
+pub(crate) fn dilate(v: u32) -> u64 {
+    let mut x = (v as u64) & 0x1f_ffff;
+    x = (x | (x << 32)) & 0x001f_0000_0000_ffff;
+    x = (x | (x << 16)) & 0x001f_0000_ff00_00ff;
+    x = (x | (x << 8)) & 0x100f_00f0_0f00_f00f;
+    x = (x | (x << 4)) & 0x10c3_0c30_c30c_30c3;
+    x = (x | (x << 2)) & X_BITS;
+    x
+}
+
+/// Inverse of [`dilate`]: gathers every third bit (from bit 0) into the low 21 bits.
+#[inline]
+pub(crate) fn undilate(v: u64) -> u32 {
+    let mut x = v & X_BITS;
+    x = (x ^ (x >> 2)) & 0x10c3_0c30_c30c_30c3;
+    x = (x ^ (x >> 4)) & 0x100f_00f0_0f00_f00f;
+    x = (x ^ (x >> 8)) & 0x001f_0000_ff00_00ff;
+    x = (x ^ (x >> 16)) & 0x001f_0000_0000_ffff;
+    x = (x ^ (x >> 32)) & 0x1f_ffff;
+    x as u32
+}
+
+impl LocationCode {
+    /// The root cell (the whole world box): the bare sentinel.
+    pub const ROOT: LocationCode = LocationCode(1);
+
+    /// The root cell.
+    #[inline]
+    pub fn root() -> LocationCode {
+        Self::ROOT
+    }
+
+    /// A code from its raw bits, if they are well formed (a sentinel at bit `3d`).
+    pub fn from_raw(raw: u64) -> Option<LocationCode> {
+        if raw == 0 || (63 - raw.leading_zeros()) % 3 != 0 {
+            None
+        } else {
+            Some(LocationCode(raw))
+        }
+    }
+
+    /// Raw bits without checking (crate-internal: callers built them by shifting a
+    /// well-formed code).
+    #[inline]
+    pub(crate) fn from_raw_unchecked(raw: u64) -> LocationCode {
+        debug_assert!(Self::from_raw(raw).is_some(), "malformed code {raw:#x}");
+        LocationCode(raw)
+    }
+
+    /// The raw `u64` (the key of the octree's hash map).
+    #[inline]
+    pub fn raw(self) -> u64 {
+        self.0
+    }
+
+    /// The cell at `depth` with integer coordinates `c` (each in `0..2^depth`), or
+    /// `None` if out of range.
+    pub fn from_coords(depth: u32, c: [u32; 3]) -> Option<LocationCode> {
+        if depth > MAX_DEPTH || c.iter().any(|&v| (v as u64) >> depth != 0) {
+            return None;
+        }
+        let bits = dilate(c[0]) | (dilate(c[1]) << 1) | (dilate(c[2]) << 2);
+        Some(LocationCode((1u64 << (3 * depth)) | bits))
+    }
+
+    /// The depth-`depth` cell containing point `p`, cells dividing `world` (the
+    /// point is clamped into `world` first; `depth` is capped at [`MAX_DEPTH`]).
+    /// Cells are half-open except on the world's upper faces.
+    pub fn of_point(world: &Aabb, p: Vec3, depth: u32) -> LocationCode {
+        let depth = depth.min(MAX_DEPTH);
+        let ext = world.extent();
+        let scale = Vec3::select(
+            ext.cmpgt(Vec3::ZERO),
+            Vec3::splat((1u32 << MAX_DEPTH) as f32) / ext,
+            Vec3::ZERO,
+        );
+        LocationCode(point_key(world.min, world.max, scale, p)).ancestor(depth)
+    }
+
+    /// Depth of the cell (root = 0).
+    #[inline]
+    pub fn depth(self) -> u32 {
+        (63 - self.0.leading_zeros()) / 3
+    }
+
+    /// The enclosing cell one level up, or `None` for the root.
+    #[inline]
+    pub fn parent(self) -> Option<LocationCode> {
+        (self.0 > 1).then_some(LocationCode(self.0 >> 3))
+    }
+
+    /// The ancestor at `depth` (itself if `depth >= self.depth()`).
+    #[inline]
+    pub fn ancestor(self, depth: u32) -> LocationCode {
+        let d = self.depth();
+        if depth >= d {
+            self
+        } else {
+            LocationCode(self.0 >> (3 * (d - depth)))
+        }
+    }
+
+    /// Child `k` (bit 0 = high x half, bit 1 = high y, bit 2 = high z), or `None`
+    /// at [`MAX_DEPTH`] or for `k > 7`.
+    #[inline]
+    pub fn child(self, k: u8) -> Option<LocationCode> {
+        (k < 8 && self.depth() < MAX_DEPTH).then_some(LocationCode((self.0 << 3) | k as u64))
+    }
+
+    /// Which child of its parent this cell is (its last 3 bits; 0 for the root).
+    #[inline]
+    pub fn child_index(self) -> u8 {
+        if self.0 == 1 {
+            0
+        } else {
+            (self.0 & 7) as u8
+        }
+    }
+
+    /// True if `other` is this cell or lies inside it.
+    #[inline]
+    pub fn contains(self, other: LocationCode) -> bool {
+        let (a, b) = (self.depth(), other.depth());
+        b >= a && other.0 >> (3 * (b - a)) == self.0
+    }
+
+    /// The smallest cell containing both (their common prefix).
+    #[inline]
+    pub fn common_ancestor(self, other: LocationCode) -> LocationCode {
+        let d = self.depth().min(other.depth());
+        let a = self.ancestor(d).0;
+        let b = other.ancestor(d).0;
+        let x = a ^ b;
+        let levels = (64 - x.leading_zeros()).div_ceil(3);
+        LocationCode(a >> (3 * levels))
+    }
+
+    /// Integer coordinates of the cell at its depth (each in `0..2^depth`).
+    #[inline]
+    pub fn coords(self) -> [u32; 3] {
+        let m = self.0 ^ (1u64 << (3 * self.depth()));
+        [undilate(m), undilate(m >> 1), undilate(m >> 2)]
+    }
+
+    /// The cell's box when the root cell is `world`: `world` split in halves
+    /// `depth` times along every axis. O(1).
+    pub fn cell_box(self, world: &Aabb) -> Aabb {
+        let d = self.depth();
+        let size = world.extent() * (1.0 / (1u32 << d) as f32);
+        cell_box_of(world.min, size, self.coords())
+    }
+
+    /// The same-depth cell across `face`, or `None` when this cell lies on that face
+    /// of the world box.
+    ///
+    /// O(1), no loop over levels: the axis' dilated coordinate is incremented by
+    /// `(a | !mask) + 1` (ones in the other axes' bits carry the increment across
+    /// them) or decremented by `a - 1` (the borrow through the other axes' bits is
+    /// masked off). The world border is where the coordinate is all ones (+) or all
+    /// zeros (−) — the seed's "every digit in the E/W/… set" test.
+    #[inline]
+    pub fn face_neighbor(self, face: Face) -> Option<LocationCode> {
+        let d = self.depth();
+        let sentinel = 1u64 << (3 * d);
+        let low = sentinel - 1;
+        let mask = (X_BITS << face.axis()) & low;
+        let a = self.0 & mask;
+        let rest = self.0 & !mask;
+        let moved = if face.is_positive() {
+            if a == mask {
+                return None;
+            }
+            ((a | !mask).wrapping_add(1)) & mask
+        } else {
+            if a == 0 {
+                return None;
+            }
+            (a - 1) & mask
+        };
+        Some(LocationCode(rest | moved))
+    }
+
+    /// Offset of the same-depth cell `other` from this one, per axis in `-1..=1`, or
+    /// `None` if it is farther than one cell on some axis or at another depth.
+    /// O(1): compares dilated coordinates directly (no decoding).
+    #[inline]
+    pub fn offset_to(self, other: LocationCode) -> Option<[i8; 3]> {
+        let d = self.depth();
+        if other.depth() != d {
+            return None;
+        }
+        let mut off = [0i8; 3];
+        for (axis, o) in off.iter_mut().enumerate() {
+            let mask = (X_BITS << axis) & ((1u64 << (3 * d)) - 1);
+            let a = self.0 & mask;
+            let b = other.0 & mask;
+            if a == b {
+                continue;
+            }
+            *o = if a != mask && b == ((a | !mask).wrapping_add(1)) & mask {
+                1
+            } else if a != 0 && b == (a - 1) & mask {
+                -1
+            } else {
+                return None;
+            };
+        }
+        Some(off)
+    }
+}
+
+/// The full-depth key (depth 21, sentinel at bit 63) of point `p`, clamped into
+/// `[min, max]`; `scale` is `2^21 / extent` per axis. Shared by
+/// [`LocationCode::of_point`] and the octree so both quantize identically.
+#[inline]
+pub(crate) fn point_key(min: Vec3, max: Vec3, scale: Vec3, p: Vec3) -> u64 {
+    let top = ((1u32 << MAX_DEPTH) - 1) as f32;
+    let q = ((p.clamp(min, max) - min) * scale)
+        .floor()
+        .clamp(Vec3::ZERO, Vec3::splat(top));
+    (1u64 << 63) | dilate(q.x as u32) | (dilate(q.y as u32) << 1) | (dilate(q.z as u32) << 2)
+}
+
+/// Box of the cell with integer coordinates `c` and edge lengths `size`, the root
+/// cell starting at `origin`. The one formula used by codes, traversals and
+/// validation, so they round identically.
+#[inline]
+pub(crate) fn cell_box_of(origin: Vec3, size: Vec3, c: [u32; 3]) -> Aabb {
+    let min = origin + Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * size;
+    Aabb::new(min, min + size)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::vec3;
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64;
+
+    fn world() -> Aabb {
+        Aabb::new(vec3(-3.0, 1.0, 10.0), vec3(5.0, 9.0, 18.0))
+    }
+
+    #[test]
+    fn dilate_round_trips_and_matches_bit_loop() {
+        let mut rng = Pcg64::seed_from_u64(7);
+        for _ in 0..10_000 {
+            let v: u32 = rng.gen_range(0..1 << 21);
+            let mut slow = 0u64;
+            for i in 0..21 {
+                slow |= (((v >> i) & 1) as u64) << (3 * i);
+            }
+            assert_eq!(dilate(v), slow);
+            assert_eq!(undilate(slow), v);
+        }
+    }
+
+    #[test]
+    fn parent_child_depth() {
+        let r = LocationCode::root();
+        assert_eq!(r.depth(), 0);
+        assert_eq!(r.parent(), None);
+        let mut c = r;
+        for d in 1..=MAX_DEPTH {
+            c = c.child((d % 8) as u8).unwrap();
+            assert_eq!(c.depth(), d);
+            assert_eq!(c.child_index(), (d % 8) as u8);
+            assert_eq!(c.parent().unwrap().depth(), d - 1);
+            assert!(r.contains(c));
+            assert_eq!(c.ancestor(0), r);
+        }
+        assert_eq!(c.child(0), None, "no level 22 in a u64");
+        assert_eq!(LocationCode::from_raw(c.raw()), Some(c));
+        assert_eq!(LocationCode::from_raw(0b10), None);
+        assert_eq!(LocationCode::from_raw(0), None);
+    }
+
+    #[test]
+    fn common_ancestor_is_longest_prefix() {
+        let mut rng = Pcg64::seed_from_u64(3);
+        for _ in 0..5000 {
+            let d1 = rng.gen_range(0..=MAX_DEPTH);
+            let d2 = rng.gen_range(0..=MAX_DEPTH);
+            let a = random_code(&mut rng, d1);
+            let b = random_code(&mut rng, d2);
+            let l = a.common_ancestor(b);
+            assert!(l.contains(a) && l.contains(b));
+            for k in 0..8 {
+                if let Some(c) = l.child(k) {
+                    assert!(!(c.contains(a) && c.contains(b)));
+                }
+            }
+        }
+    }
+
+    fn random_code(rng: &mut Pcg64, d: u32) -> LocationCode {
+        let n = 1u32 << d;
+        LocationCode::from_coords(
+            d,
+            [
+                rng.gen_range(0..n),
+                rng.gen_range(0..n),
+                rng.gen_range(0..n),
+            ],
+        )
+        .unwrap()
+    }
+
+    /// Geometric definition: shift the cell's box by one cell size along the axis
+    /// and take the code of the shifted box's centre (or nothing if it leaves the
+    /// world).
+    fn geometric_neighbor(c: LocationCode, f: Face, w: &Aabb) -> Option<LocationCode> {
+        let b = c.cell_box(w);
+        let mut shift = Vec3::ZERO;
+        let size = b.extent();
+        shift[f.axis()] = if f.is_positive() {
+            size[f.axis()]
+        } else {
+            -size[f.axis()]
+        };
+        let centre = b.center() + shift;
+        if !w.contains_point(centre) {
+            return None;
+        }
+        Some(LocationCode::of_point(w, centre, c.depth()))
+    }
+
+    #[test]
+    fn face_neighbor_matches_geometry_for_every_code_to_depth_4() {
+        let w = world();
+        let mut n = 0;
+        for d in 0..=4u32 {
+            let side = 1u32 << d;
+            for x in 0..side {
+                for y in 0..side {
+                    for z in 0..side {
+                        let c = LocationCode::from_coords(d, [x, y, z]).unwrap();
+                        assert_eq!(c.coords(), [x, y, z]);
+                        assert_eq!(LocationCode::of_point(&w, c.cell_box(&w).center(), d), c);
+                        for f in Face::ALL {
+                            let got = c.face_neighbor(f);
+                            assert_eq!(got, geometric_neighbor(c, f, &w), "{c:?} {f:?}");
+                            if let Some(nb) = got {
+                                assert_eq!(nb.face_neighbor(f.opposite()), Some(c));
+                                let mut off = [0i8; 3];
+                                off[f.axis()] = if f.is_positive() { 1 } else { -1 };
+                                assert_eq!(c.offset_to(nb), Some(off));
+                            }
+                            n += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(n, 6 * (1 + 8 + 64 + 512 + 4096));
+    }
+
+    #[test]
+    fn face_neighbor_matches_geometry_at_depth_21() {
+        // A power-of-two world keeps depth-21 cell centres exact in f32.
+        let w = Aabb::new(Vec3::splat(-1024.0), Vec3::splat(1024.0));
+        let mut rng = Pcg64::seed_from_u64(21);
+        let top = (1u32 << 21) - 1;
+        for i in 0..20_000 {
+            let mut c = random_code(&mut rng, 21);
+            if i % 10 == 0 {
+                // Force border cells.
+                let mut xyz = c.coords();
+                xyz[i % 3] = if i % 20 == 0 { 0 } else { top };
+                c = LocationCode::from_coords(21, xyz).unwrap();
+            }
+            for f in Face::ALL {
+                assert_eq!(
+                    c.face_neighbor(f),
+                    geometric_neighbor(c, f, &w),
+                    "{c:?} {f:?}"
+                );
+                let mut xyz = c.coords();
+                let a = f.axis();
+                let expect = if f.is_positive() {
+                    (xyz[a] < top).then(|| xyz[a] += 1)
+                } else {
+                    (xyz[a] > 0).then(|| xyz[a] -= 1)
+                };
+                assert_eq!(
+                    c.face_neighbor(f),
+                    expect.map(|_| LocationCode::from_coords(21, xyz).unwrap())
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn offsets_reject_far_cells_and_other_depths() {
+        let c = LocationCode::from_coords(3, [3, 3, 3]).unwrap();
+        assert_eq!(
+            c.offset_to(LocationCode::from_coords(3, [4, 2, 3]).unwrap()),
+            Some([1, -1, 0])
+        );
+        assert_eq!(
+            c.offset_to(LocationCode::from_coords(3, [5, 3, 3]).unwrap()),
+            None
+        );
+        assert_eq!(c.offset_to(c.parent().unwrap()), None);
+        assert_eq!(c.offset_to(c), Some([0, 0, 0]));
+    }
+}

@@ -1,0 +1,263 @@
+//! Node storage and the map from location code to node: the helpers every other
+//! concern (insert, moves, queries, validation) builds on.
+
+use super::code::{cell_box_of, point_key, LocationCode, MAX_DEPTH};
+use super::LinearOctree;
+use crate::arena::{Arena, Handle, Pool};
+use crate::geom::{Aabb, Sphere};
+use glam::Vec3;
+
+/// "No node" in parent/child links.
+pub(super) const NONE: u32 = u32::MAX;
+
+/// An object as its leaf stores it: the sphere is copied here so that scans of a
+/// leaf read contiguous memory. 32 bytes.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Item {
+    pub sphere: Sphere,
+    pub handle: Handle,
+    /// Radius plus the distance the centre was clamped by (see [`Obj::ext`]).
+    pub ext: f32,
+}
+
+/// An object as the arena stores it.
+#[derive(Clone, Debug)]
+pub(super) struct Obj<T> {
+    pub sphere: Sphere,
+    /// Depth-21 code of the (clamped) centre; its prefix is the leaf's code.
+    pub key: u64,
+    /// Extent used for loose bounds: the radius, plus the L∞ distance from the
+    /// centre to the clamped placement point when the centre is outside the cube.
+    pub ext: f32,
+    /// Leaf node index and position in its item list.
+    pub leaf: u32,
+    pub slot: u32,
+    pub value: T,
+}
+
+/// A node. A leaf holds items and no children; an inner node holds children
+/// (indices, `NONE` where an octant is empty space) and no items.
+#[derive(Clone, Debug)]
+pub(super) struct Node {
+    pub code: LocationCode,
+    pub parent: u32,
+    /// Objects in the subtree.
+    pub count: u32,
+    /// Largest object extent in the subtree; never smaller than the truth (it may
+    /// be larger until a removal or merge refits it).
+    pub max_extent: f32,
+    pub leaf: bool,
+    pub children: [u32; 8],
+    pub items: Vec<Item>,
+}
+
+impl<T> LinearOctree<T> {
+    /// Allocates a leaf for `code` (child of `parent`) and registers it in the map.
+    pub(super) fn new_node(&mut self, code: LocationCode, parent: u32) -> u32 {
+        let items = self.spare.pop().unwrap_or_default();
+        let i = self.nodes.alloc(Node {
+            code,
+            parent,
+            count: 0,
+            max_extent: 0.0,
+            leaf: true,
+            children: [NONE; 8],
+            items,
+        });
+        self.map.insert(code.raw(), i);
+        self.per_depth[code.depth() as usize] += 1;
+        if parent != NONE {
+            self.nodes[parent].children[code.child_index() as usize] = i;
+        }
+        i
+    }
+
+    /// Unregisters and frees node `i` (not its children), keeping its item list's
+    /// memory for reuse, and unlinks it from its parent.
+    pub(super) fn free_node(&mut self, i: u32) {
+        let node = &mut self.nodes[i];
+        let mut items = std::mem::take(&mut node.items);
+        let (code, parent) = (node.code, node.parent);
+        items.clear();
+        if items.capacity() > 0 {
+            self.spare.push(items);
+        }
+        self.map.remove(&code.raw());
+        self.per_depth[code.depth() as usize] -= 1;
+        if parent != NONE {
+            let slot = &mut self.nodes[parent].children[code.child_index() as usize];
+            if *slot == i {
+                *slot = NONE;
+            }
+        }
+        self.nodes.free(i);
+    }
+
+    /// The box of the cell at depth `d` with integer coordinates `c`.
+    #[inline]
+    pub(super) fn cell_of(&self, c: [u32; 3], d: u32) -> Aabb {
+        cell_box_of(self.cube.min, Vec3::splat(self.cell_size[d as usize]), c)
+    }
+
+    /// The loose box of a node: its cell grown by its largest extent and the
+    /// rounding slack. Every sphere stored below lies inside it.
+    #[inline]
+    pub(super) fn loose_of(&self, c: [u32; 3], d: u32, max_extent: f32) -> Aabb {
+        self.cell_of(c, d).grown(max_extent + self.slack)
+    }
+
+    /// Placement of a sphere: the depth-21 key of its clamped centre and its extent.
+    #[inline]
+    pub(super) fn placement(&self, s: &Sphere) -> (u64, f32) {
+        let key = point_key(self.cube.min, self.cube.max, self.scale, s.center);
+        let clamped = s.center.clamp(self.cube.min, self.cube.max);
+        let off = (s.center - clamped).abs().max_element();
+        // The factor absorbs the rounding of `off` and of `radius + off`.
+        let ext = if off > 0.0 {
+            (s.radius + off) * (1.0 + 16.0 * f32::EPSILON)
+        } else {
+            s.radius
+        };
+        (key, ext)
+    }
+
+    /// Deepest existing node on the chain of cells containing `key`: a binary
+    /// search over depths (the nodes on a chain exist from the root down to some
+    /// depth, so "exists" is monotone), bounded by the deepest populated level.
+    /// ≈ log2(depth) map lookups.
+    pub(super) fn locate(&self, key: u64) -> u32 {
+        let mut lo = 0u32; // the root always exists
+        let mut hi = (0..=MAX_DEPTH)
+            .rev()
+            .find(|&d| self.per_depth[d as usize] > 0)
+            .unwrap_or(0);
+        let mut found = self.root;
+        while lo < hi {
+            let mid = (lo + hi).div_ceil(2);
+            match self.map.get(&(key >> (3 * (MAX_DEPTH - mid)))) {
+                Some(&i) => {
+                    lo = mid;
+                    found = i;
+                }
+                None => hi = mid - 1,
+            }
+        }
+        // `found` is always the node at depth `lo`.
+        found
+    }
+
+    /// Goes down from node `i` toward `key` to the leaf containing it, creating the
+    /// leaf where the path enters empty space.
+    pub(super) fn descend_to_leaf(&mut self, mut i: u32, key: u64) -> u32 {
+        loop {
+            let n = &self.nodes[i];
+            if n.leaf {
+                return i;
+            }
+            let d = n.code.depth() + 1;
+            let child_code = key >> (3 * (MAX_DEPTH - d));
+            let c = n.children[(child_code & 7) as usize];
+            if c == NONE {
+                return self.new_node(LocationCode::from_raw_unchecked(child_code), i);
+            }
+            i = c;
+        }
+    }
+
+    /// Puts the item at the end of leaf `leaf`'s list and records where it is.
+    #[inline]
+    pub(super) fn push_item(&mut self, leaf: u32, item: Item) {
+        let items = &mut self.nodes[leaf].items;
+        let slot = items.len() as u32;
+        items.push(item);
+        let o = self.obj_mut(item.handle);
+        o.leaf = leaf;
+        o.slot = slot;
+    }
+
+    /// Removes the item at `slot` of `leaf` (swap-remove, fixing the moved item's
+    /// slot) and returns it.
+    #[inline]
+    pub(super) fn take_item(&mut self, leaf: u32, slot: u32) -> Item {
+        let items = &mut self.nodes[leaf].items;
+        let item = items.swap_remove(slot as usize);
+        if let Some(moved) = items.get(slot as usize).map(|m| m.handle) {
+            self.obj_mut(moved).slot = slot;
+        }
+        item
+    }
+
+    #[inline]
+    pub(super) fn obj_mut(&mut self, h: Handle) -> &mut Obj<T> {
+        self.objects
+            .get_mut(h)
+            .expect("octree item names a live object")
+    }
+
+    #[inline]
+    pub(super) fn obj(&self, h: Handle) -> &Obj<T> {
+        self.objects
+            .get(h)
+            .expect("octree item names a live object")
+    }
+
+    /// Adds `delta` to the counts from `from` up to, not including, `stop` (`NONE`:
+    /// through the root).
+    #[inline]
+    pub(super) fn add_count(&mut self, mut from: u32, stop: u32, delta: i32) {
+        while from != stop && from != NONE {
+            let n = &mut self.nodes[from];
+            n.count = n.count.wrapping_add_signed(delta);
+            from = n.parent;
+        }
+    }
+
+    /// Raises `max_extent` from `from` upward to at least `ext`; stops at the first
+    /// node already that large (its ancestors are too).
+    #[inline]
+    pub(super) fn grow_extent(&mut self, mut from: u32, ext: f32) {
+        while from != NONE {
+            let n = &mut self.nodes[from];
+            if n.max_extent >= ext {
+                return;
+            }
+            n.max_extent = ext;
+            from = n.parent;
+        }
+    }
+
+    /// Shrinks `max_extent` to the truth at node `from` (from its items or its
+    /// children) and propagates upward while it changes. This is the only place the
+    /// bounds shrink besides splits and merges: removals and moves call it when the
+    /// object leaving a leaf may have been its largest.
+    pub(super) fn refit_extent(&mut self, mut from: u32) {
+        while from != NONE {
+            let n = &self.nodes[from];
+            let new = if n.leaf {
+                n.items.iter().fold(0.0f32, |m, it| m.max(it.ext))
+            } else {
+                n.children
+                    .iter()
+                    .filter(|&&c| c != NONE)
+                    .fold(0.0f32, |m, &c| m.max(self.nodes[c].max_extent))
+            };
+            if new == n.max_extent {
+                return;
+            }
+            let parent = n.parent;
+            self.nodes[from].max_extent = new;
+            from = parent;
+        }
+    }
+
+    /// Empties the tree (handles go stale, memory is released).
+    pub(super) fn clear_all(&mut self) {
+        self.objects = Arena::new();
+        self.nodes = Pool::default();
+        self.map = Default::default();
+        self.spare = Vec::new();
+        self.per_depth = [0; MAX_DEPTH as usize + 1];
+        self.counters = Default::default();
+        self.root = self.new_node(LocationCode::ROOT, NONE);
+    }
+}

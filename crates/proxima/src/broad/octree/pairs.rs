@@ -1,0 +1,170 @@
+//! All overlapping pairs by a simultaneous traversal of the tree with itself,
+//! pruned by loose boxes (each pair of objects is met exactly once: in the leaf
+//! they share, or in the one pair of sibling subtrees that separates them).
+
+use super::node::{Node, NONE};
+use super::query::child_coords;
+use super::LinearOctree;
+use crate::arena::Handle;
+use crate::geom::{overlap, Aabb};
+use std::ops::ControlFlow;
+
+/// A node with its cell coordinates, depth and loose box, as the pair traversal
+/// carries it.
+#[derive(Clone, Copy)]
+struct Visit {
+    i: u32,
+    c: [u32; 3],
+    d: u32,
+    loose: Aabb,
+}
+
+impl<T> LinearOctree<T> {
+    pub(super) fn pairs_tree<F>(&self, f: &mut F) -> ControlFlow<()>
+    where
+        F: FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    {
+        if self.objects.len() < 2 {
+            return ControlFlow::Continue(());
+        }
+        self.self_pairs(self.visit(self.root, [0; 3], 0), f)
+    }
+
+    #[inline]
+    fn visit(&self, i: u32, c: [u32; 3], d: u32) -> Visit {
+        Visit {
+            i,
+            c,
+            d,
+            loose: self.loose_of(c, d, self.nodes[i].max_extent),
+        }
+    }
+
+    #[inline]
+    fn child_visits(&self, v: &Visit, out: &mut [Visit; 8]) -> usize {
+        let mut n = 0;
+        for (k, &ch) in self.nodes[v.i].children.iter().enumerate() {
+            if ch != NONE {
+                out[n] = self.visit(ch, child_coords(v.c, k), v.d + 1);
+                n += 1;
+            }
+        }
+        n
+    }
+
+    /// Pairs with both objects below `v`.
+    fn self_pairs<F>(&self, v: Visit, f: &mut F) -> ControlFlow<()>
+    where
+        F: FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    {
+        let n = &self.nodes[v.i];
+        if n.count < 2 {
+            return ControlFlow::Continue(());
+        }
+        if n.leaf {
+            let items = &n.items;
+            for (a, ia) in items.iter().enumerate() {
+                for ib in &items[a + 1..] {
+                    if overlap::sphere_sphere(&ia.sphere, &ib.sphere) {
+                        self.report(ia.handle, ib.handle, f)?;
+                    }
+                }
+            }
+            return ControlFlow::Continue(());
+        }
+        let mut kids = [v; 8];
+        let m = self.child_visits(&v, &mut kids);
+        for a in 0..m {
+            self.self_pairs(kids[a], f)?;
+            for b in a + 1..m {
+                self.cross_pairs(kids[a], kids[b], f)?;
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Pairs with one object below `a` and one below `b` (disjoint subtrees).
+    fn cross_pairs<F>(&self, a: Visit, b: Visit, f: &mut F) -> ControlFlow<()>
+    where
+        F: FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    {
+        if !overlap::aabb_aabb(&a.loose, &b.loose) {
+            return ControlFlow::Continue(());
+        }
+        let (na, nb): (&Node, &Node) = (&self.nodes[a.i], &self.nodes[b.i]);
+        match (na.leaf, nb.leaf) {
+            (true, true) => {
+                // Only spheres reaching the other leaf's loose box can overlap
+                // anything there: filter `b` once (into a stack buffer; a huge
+                // leaf at max depth falls back to no filter), then each of `a`.
+                let mut buf = [0u16; 64];
+                let mut m = 0;
+                let filtered = nb.items.len() <= buf.len();
+                if filtered {
+                    for (k, ib) in nb.items.iter().enumerate() {
+                        if overlap::sphere_aabb(&ib.sphere, &a.loose) {
+                            buf[m] = k as u16;
+                            m += 1;
+                        }
+                    }
+                    if m == 0 {
+                        return ControlFlow::Continue(());
+                    }
+                }
+                for ia in &na.items {
+                    if !overlap::sphere_aabb(&ia.sphere, &b.loose) {
+                        continue;
+                    }
+                    if filtered {
+                        for &k in &buf[..m] {
+                            let ib = &nb.items[k as usize];
+                            if overlap::sphere_sphere(&ia.sphere, &ib.sphere) {
+                                self.report(ia.handle, ib.handle, f)?;
+                            }
+                        }
+                    } else {
+                        for ib in &nb.items {
+                            if overlap::sphere_sphere(&ia.sphere, &ib.sphere) {
+                                self.report(ia.handle, ib.handle, f)?;
+                            }
+                        }
+                    }
+                }
+                ControlFlow::Continue(())
+            }
+            // Descend the inner node; of two inner nodes, the larger (shallower) one.
+            (false, true) => self.cross_children(a, b, f),
+            (true, false) => self.cross_children(b, a, f),
+            (false, false) => {
+                if a.d <= b.d {
+                    self.cross_children(a, b, f)
+                } else {
+                    self.cross_children(b, a, f)
+                }
+            }
+        }
+    }
+
+    /// Crosses each child of inner node `split` with `other`.
+    fn cross_children<F>(&self, split: Visit, other: Visit, f: &mut F) -> ControlFlow<()>
+    where
+        F: FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    {
+        let mut kids = [split; 8];
+        let m = self.child_visits(&split, &mut kids);
+        for kid in &kids[..m] {
+            if overlap::aabb_aabb(&kid.loose, &other.loose) {
+                self.cross_pairs(*kid, other, f)?;
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    #[inline]
+    fn report<F>(&self, a: Handle, b: Handle, f: &mut F) -> ControlFlow<()>
+    where
+        F: FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    {
+        f(a, &self.obj(a).value, b, &self.obj(b).value)
+    }
+}

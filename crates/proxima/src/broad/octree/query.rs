@@ -1,0 +1,97 @@
+//! Queries: one top-down traversal for every [`Selection`], with loose boxes
+//! (seed 004 §3.2.3: classify cells against the frustum as outside / inside /
+//! intersecting).
+
+use super::node::NONE;
+use super::LinearOctree;
+use crate::arena::Handle;
+use crate::broad::Selection;
+use crate::geom::{Frustum, Relation, Sphere};
+use std::ops::ControlFlow;
+
+/// Child `k`'s integer coordinates from its parent's.
+#[inline]
+pub(super) fn child_coords(c: [u32; 3], k: usize) -> [u32; 3] {
+    [
+        c[0] * 2 + (k & 1) as u32,
+        c[1] * 2 + ((k >> 1) & 1) as u32,
+        c[2] * 2 + ((k >> 2) & 1) as u32,
+    ]
+}
+
+impl<T> LinearOctree<T> {
+    /// Traverses the tree for `q`. A node's loose box is classified once: `Outside`
+    /// prunes the subtree, `Inside` reports it whole without testing its spheres,
+    /// `Intersecting` goes on (a leaf tests each sphere with `q.selects`). The plane
+    /// mask returned for a node is what its children are tested against, so a
+    /// frustum plane that contains a parent is never tested again below it.
+    /// Recursion depth ≤ 22; no allocation.
+    pub(super) fn visit_tree<Q, F>(&self, q: &Q, f: &mut F) -> ControlFlow<()>
+    where
+        Q: Selection + ?Sized,
+        F: FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    {
+        if self.objects.is_empty() {
+            return ControlFlow::Continue(());
+        }
+        self.visit_node(self.root, [0; 3], 0, Frustum::ALL_PLANES, q, f)
+    }
+
+    fn visit_node<Q, F>(
+        &self,
+        i: u32,
+        c: [u32; 3],
+        d: u32,
+        mask: u8,
+        q: &Q,
+        f: &mut F,
+    ) -> ControlFlow<()>
+    where
+        Q: Selection + ?Sized,
+        F: FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    {
+        let n = &self.nodes[i];
+        let (rel, mask) = q.classify_box(&self.loose_of(c, d, n.max_extent), mask);
+        match rel {
+            Relation::Outside => ControlFlow::Continue(()),
+            Relation::Inside => self.report_all(i, f),
+            Relation::Intersecting => {
+                if n.leaf {
+                    for it in &n.items {
+                        if q.selects(&it.sphere) {
+                            f(it.handle, &it.sphere, &self.obj(it.handle).value)?;
+                        }
+                    }
+                } else {
+                    for (k, &ch) in n.children.iter().enumerate() {
+                        if ch != NONE {
+                            self.visit_node(ch, child_coords(c, k), d + 1, mask, q, f)?;
+                        }
+                    }
+                }
+                ControlFlow::Continue(())
+            }
+        }
+    }
+
+    /// Reports every object below node `i` without testing (its loose box is
+    /// inside the query).
+    fn report_all<F>(&self, i: u32, f: &mut F) -> ControlFlow<()>
+    where
+        F: FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    {
+        let n = &self.nodes[i];
+        if n.leaf {
+            for it in &n.items {
+                f(it.handle, &it.sphere, &self.obj(it.handle).value)?;
+            }
+        } else {
+            for &ch in &n.children {
+                if ch != NONE {
+                    self.report_all(ch, f)?;
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
+}

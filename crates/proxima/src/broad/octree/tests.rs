@@ -1,0 +1,472 @@
+//! Octree-specific tests (the generic oracle suite in `tests/oracle` covers the
+//! queries and pairs against brute force).
+
+use super::*;
+use crate::broad::SpatialIndex;
+use crate::geom::{Frustum, Relation, Sphere};
+use glam::{vec3, Mat4};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+use std::cell::Cell;
+
+/// A power-of-two world so cell boxes and centres are exact in f32.
+fn world() -> Aabb {
+    Aabb::new(Vec3::ZERO, Vec3::splat(64.0))
+}
+
+fn cfg(max_per_leaf: u32, merge_below: u32, max_depth: u32) -> OctreeConfig {
+    OctreeConfig {
+        max_per_leaf,
+        merge_below,
+        max_depth,
+    }
+}
+
+/// Integer box of a cell at depth-21 resolution: `[lo, hi)` per axis.
+fn ibox(c: LocationCode) -> ([u64; 3], [u64; 3]) {
+    let s = 1u64 << (MAX_DEPTH - c.depth());
+    let xyz = c.coords();
+    let lo = xyz.map(|v| v as u64 * s);
+    (lo, lo.map(|v| v + s))
+}
+
+fn all_leaves<T>(t: &LinearOctree<T>) -> Vec<LocationCode> {
+    let mut v = Vec::new();
+    t.for_each_leaf(|c, _| v.push(c));
+    v.sort();
+    v
+}
+
+/// Brute force: leaves overlapping the neighbour cell `n` (positive volume) whose
+/// extent reaches the face `n` shares with `code`.
+fn brute_face_neighbors(leaves: &[LocationCode], code: LocationCode, f: Face) -> Vec<LocationCode> {
+    let Some(n) = code.face_neighbor(f) else {
+        return vec![];
+    };
+    let (nlo, nhi) = ibox(n);
+    let a = f.axis();
+    let mut out: Vec<_> = leaves
+        .iter()
+        .copied()
+        .filter(|&l| {
+            let (lo, hi) = ibox(l);
+            let overlap = (0..3).all(|k| lo[k] < nhi[k] && nlo[k] < hi[k]);
+            let reaches = if f.is_positive() {
+                lo[a] <= nlo[a]
+            } else {
+                hi[a] >= nhi[a]
+            };
+            overlap && reaches
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+/// Brute force for a node `code`: leaves sharing a face patch (positive area) with
+/// it across `f`.
+fn brute_face_patch(leaves: &[LocationCode], code: LocationCode, f: Face) -> Vec<LocationCode> {
+    let (clo, chi) = ibox(code);
+    let a = f.axis();
+    let mut out: Vec<_> = leaves
+        .iter()
+        .copied()
+        .filter(|&l| {
+            let (lo, hi) = ibox(l);
+            let touches = if f.is_positive() {
+                lo[a] == chi[a]
+            } else {
+                hi[a] == clo[a]
+            };
+            touches
+                && (0..3)
+                    .filter(|&k| k != a)
+                    .all(|k| lo[k] < chi[k] && clo[k] < hi[k])
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+fn clustered_tree(seed: u64, n: usize) -> LinearOctree<usize> {
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let mut t = LinearOctree::new(world(), cfg(2, 1, 8)).unwrap();
+    let centres = [
+        vec3(10.0, 10.0, 10.0),
+        vec3(40.0, 20.0, 50.0),
+        vec3(33.0, 33.0, 33.0),
+    ];
+    for i in 0..n {
+        let c = if rng.gen_bool(0.7) {
+            centres[i % 3]
+                + vec3(
+                    rng.gen_range(-3.0..3.0),
+                    rng.gen_range(-3.0..3.0),
+                    rng.gen_range(-3.0..3.0),
+                )
+        } else {
+            vec3(
+                rng.gen_range(0.0..64.0),
+                rng.gen_range(0.0..64.0),
+                rng.gen_range(0.0..64.0),
+            )
+        };
+        t.insert(Sphere::new(c, 0.5), i).unwrap();
+    }
+    t.validate().unwrap();
+    t
+}
+
+#[test]
+fn face_neighbors_across_depths_match_brute_force() {
+    for seed in 0..4 {
+        let t = clustered_tree(seed, 300);
+        let leaves = all_leaves(&t);
+        let depths: std::collections::BTreeSet<u32> = leaves.iter().map(|c| c.depth()).collect();
+        assert!(
+            depths.len() >= 4,
+            "want leaves at many depths, got {depths:?}"
+        );
+        let mut nodes: Vec<LocationCode> = t.map.values().map(|&i| t.nodes[i].code).collect();
+        nodes.sort();
+        let (mut up, mut down) = (0, 0);
+        for &c in &nodes {
+            for f in Face::ALL {
+                let mut got = t.face_neighbors(c, f);
+                got.sort();
+                assert_eq!(got, brute_face_neighbors(&leaves, c, f), "{c:?} {f:?}");
+                // For a node, that is exactly the leaves sharing a face patch.
+                assert_eq!(got, brute_face_patch(&leaves, c, f), "{c:?} {f:?}");
+                up += got.iter().filter(|g| g.depth() < c.depth()).count();
+                down += got.iter().filter(|g| g.depth() > c.depth()).count();
+            }
+        }
+        assert!(
+            up > 0 && down > 0,
+            "both larger and smaller neighbours occur"
+        );
+        // Arbitrary codes (mostly not nodes) at every depth.
+        let mut rng = Pcg64::seed_from_u64(seed + 100);
+        for _ in 0..3000 {
+            let d = rng.gen_range(0..=9u32);
+            let n = 1u32 << d;
+            let c = LocationCode::from_coords(
+                d,
+                [
+                    rng.gen_range(0..n),
+                    rng.gen_range(0..n),
+                    rng.gen_range(0..n),
+                ],
+            )
+            .unwrap();
+            for f in Face::ALL {
+                let mut got = t.face_neighbors(c, f);
+                got.sort();
+                assert_eq!(got, brute_face_neighbors(&leaves, c, f), "{c:?} {f:?}");
+            }
+        }
+    }
+}
+
+/// The seed's experiment (§4): 12 objects moving freely through an octree split
+/// down to one object per leaf, validated after every frame. Every move is
+/// classified independently by geometry (where the new centre lies relative to
+/// the old leaf's box) and the stats must show the matching path.
+#[test]
+fn twelve_moving_objects_use_the_neighbour_path() {
+    let mut rng = Pcg64::seed_from_u64(4);
+    let w = world();
+    let mut t: LinearOctree<usize> = LinearOctree::new(w, cfg(1, 1, 10)).unwrap();
+    let mut pos = Vec::new();
+    let mut vel = Vec::new();
+    let mut hs = Vec::new();
+    for i in 0..12 {
+        let p = vec3(
+            rng.gen_range(1.0..63.0),
+            rng.gen_range(1.0..63.0),
+            rng.gen_range(1.0..63.0),
+        );
+        let v = vec3(
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+        ) * 0.4;
+        hs.push(t.insert(Sphere::new(p, 0.7), i).unwrap());
+        pos.push(p);
+        vel.push(v);
+    }
+    t.validate().unwrap();
+    let (mut expect_same, mut expect_face, mut expect_diag, mut expect_jump) =
+        (0u64, 0u64, 0u64, 0u64);
+    let mut max_depth_seen = 0;
+    for frame in 0..5000 {
+        for i in 0..12 {
+            let mut p = pos[i] + vel[i];
+            for a in 0..3 {
+                if p[a] < 0.0 || p[a] > 64.0 {
+                    vel[i][a] = -vel[i][a];
+                    p[a] = p[a].clamp(0.0, 64.0);
+                }
+            }
+            if rng.gen_bool(0.002) {
+                // An occasional teleport: a long jump.
+                p = vec3(
+                    rng.gen_range(0.0..64.0),
+                    rng.gen_range(0.0..64.0),
+                    rng.gen_range(0.0..64.0),
+                );
+            }
+            // Classify by geometry before the move.
+            let leaf = t.leaf_of(hs[i]).unwrap();
+            let b = t.cell_box(leaf);
+            let size = b.extent().x;
+            // The world's top faces belong to the last cells.
+            let pin = p.min(Vec3::splat(64.0 - 1e-3));
+            let off = ((pin - b.min) / size).floor();
+            let inside_world =
+                |q: Vec3| q.cmpge(Vec3::ZERO).all() && q.cmple(Vec3::splat(64.0)).all();
+            assert!(inside_world(p));
+            let nz = (0..3).filter(|&a| off[a] != 0.0).count();
+            let adjacent = (0..3).all(|a| (-1.0..=1.0).contains(&off[a]));
+            let before = t.stats();
+            t.update(hs[i], Sphere::new(p, 0.7)).unwrap();
+            let after = t.stats();
+            if nz == 0 {
+                expect_same += 1;
+            } else if adjacent && nz == 1 {
+                expect_face += 1;
+                assert_eq!(
+                    after.face_moves,
+                    before.face_moves + 1,
+                    "frame {frame}: face move {leaf:?} {b:?} {p} {off} {before:?} {after:?} -> {:?}", t.leaf_of(hs[i])
+                );
+                let resolved =
+                    (after.neighbor_same_depth + after.neighbor_up + after.neighbor_down)
+                        - (before.neighbor_same_depth + before.neighbor_up + before.neighbor_down);
+                assert_eq!(resolved, 1);
+            } else if adjacent {
+                expect_diag += 1;
+            } else {
+                expect_jump += 1;
+                assert_eq!(
+                    after.jump_moves,
+                    before.jump_moves + 1,
+                    "frame {frame}: jump"
+                );
+            }
+            pos[i] = p;
+        }
+        t.validate()
+            .unwrap_or_else(|e| panic!("frame {frame}: {e}"));
+        max_depth_seen = max_depth_seen.max(t.stats().depth);
+    }
+    let s = t.stats();
+    assert_eq!(s.same_leaf_moves, expect_same);
+    assert_eq!(s.face_moves, expect_face);
+    assert_eq!(s.edge_corner_moves, expect_diag);
+    assert_eq!(s.jump_moves, expect_jump);
+    eprintln!("seed experiment: {s:?}");
+    assert!(s.face_moves > 1000, "{s:?}");
+    assert!(s.jump_moves > 10, "{s:?}");
+    // Neighbours at other depths occur and are resolved by going up or down.
+    assert!(s.neighbor_up > 0 && s.neighbor_down > 0, "{s:?}");
+    assert!(s.splits > 0 && s.merges > 0, "{s:?}");
+    assert!(
+        max_depth_seen >= 4,
+        "tree should be deep, got {max_depth_seen}"
+    );
+    // Every object is where a fresh tree would put it: a leaf holding its centre.
+    for (i, h) in hs.iter().enumerate() {
+        assert!(t.leaf_of(*h).unwrap().contains(LocationCode::of_point(
+            t.root_cell(),
+            pos[i],
+            MAX_DEPTH
+        )));
+    }
+}
+
+#[test]
+fn border_oscillation_does_not_split_and_merge_every_frame() {
+    let mut t: LinearOctree<u32> = LinearOctree::new(world(), cfg(4, 2, 10)).unwrap();
+    // Four objects in the low-x half of the root, one oscillating across x = 32.
+    for i in 0..4 {
+        t.insert(Sphere::new(vec3(10.0 + i as f32, 10.0, 10.0), 0.5), i)
+            .unwrap();
+    }
+    let h = t
+        .insert(Sphere::new(vec3(31.9, 10.0, 10.0), 0.5), 9)
+        .unwrap();
+    t.validate().unwrap();
+    let s0 = t.stats();
+    for frame in 0..1000 {
+        let x = if frame % 2 == 0 { 32.1 } else { 31.9 };
+        t.update(h, Sphere::new(vec3(x, 10.0, 10.0), 0.5)).unwrap();
+        t.validate().unwrap();
+    }
+    let s = t.stats();
+    assert_eq!(
+        (s.splits, s.merges),
+        (s0.splits, s0.merges),
+        "{s0:?} -> {s:?}"
+    );
+    assert_eq!(s.face_moves - s0.face_moves, 1000);
+
+    // The tightest allowed setting, merge_below = max_per_leaf, still has one
+    // object of hysteresis: an object moving in and out of a full leaf's cell
+    // splits it once (5 > 4) and never merges it back (4 is not below 4).
+    let mut t: LinearOctree<u32> = LinearOctree::new(world(), cfg(4, 4, 10)).unwrap();
+    for i in 0..4 {
+        t.insert(Sphere::new(vec3(10.0 + i as f32, 10.0, 10.0), 0.5), i)
+            .unwrap();
+    }
+    let h = t
+        .insert(Sphere::new(vec3(40.0, 10.0, 10.0), 0.5), 9)
+        .unwrap();
+    let mut after_first = None;
+    for frame in 0..100 {
+        let x = if frame % 2 == 0 { 14.0 } else { 40.0 };
+        t.update(h, Sphere::new(vec3(x, 10.0, 10.0), 0.5)).unwrap();
+        t.validate().unwrap();
+        if frame == 1 {
+            after_first = Some(t.stats());
+        }
+    }
+    // The first entry splits the full leaf (a cascade, once); after that the
+    // structure never changes again.
+    let (s1, s) = (after_first.unwrap(), t.stats());
+    assert!(s1.splits > 0, "{s1:?}");
+    assert_eq!(
+        (s.splits, s.merges),
+        (s1.splits, s1.merges),
+        "{s1:?} -> {s:?}"
+    );
+}
+
+#[test]
+fn config_and_world_are_validated() {
+    let w = world();
+    assert!(LinearOctree::<()>::new(w, cfg(0, 0, 8)).is_err());
+    assert!(LinearOctree::<()>::new(w, cfg(4, 5, 8)).is_err());
+    assert!(LinearOctree::<()>::new(w, cfg(4, 2, 22)).is_err());
+    assert!(LinearOctree::<()>::new(Aabb::new(Vec3::ONE, Vec3::ZERO), cfg(4, 2, 8)).is_err());
+    assert!(
+        LinearOctree::<()>::new(Aabb::new(Vec3::ZERO, Vec3::splat(f32::NAN)), cfg(4, 2, 8))
+            .is_err()
+    );
+    assert!(LinearOctree::<()>::new(w, cfg(4, 0, 21)).is_ok());
+    // A degenerate (point) world still works: everything is clamped onto it.
+    let mut t =
+        LinearOctree::new(Aabb::new(Vec3::ONE, Vec3::ONE), OctreeConfig::default()).unwrap();
+    for i in 0..50 {
+        t.insert(Sphere::new(vec3(i as f32, 0.0, -(i as f32)), 1.0), i)
+            .unwrap();
+    }
+    t.validate().unwrap();
+    assert_eq!(t.within(vec3(49.0, 0.0, -49.0), 0.3).unwrap().len(), 1);
+}
+
+#[test]
+fn merge_disabled_still_deletes_empty_leaves() {
+    let mut t: LinearOctree<usize> = LinearOctree::new(world(), cfg(1, 0, 8)).unwrap();
+    let mut rng = Pcg64::seed_from_u64(9);
+    let hs: Vec<_> = (0..200)
+        .map(|i| {
+            let p = vec3(
+                rng.gen_range(0.0..64.0),
+                rng.gen_range(0.0..64.0),
+                rng.gen_range(0.0..64.0),
+            );
+            t.insert(Sphere::new(p, 0.1), i).unwrap()
+        })
+        .collect();
+    t.validate().unwrap();
+    for h in hs {
+        t.remove(h).unwrap();
+        t.validate().unwrap();
+    }
+    let s = t.stats();
+    assert_eq!((s.nodes, s.leaves, s.merges), (1, 1, 0), "{s:?}");
+}
+
+/// Counts how often spheres are tested one by one.
+struct Counting<'a> {
+    inner: Frustum,
+    tests: &'a Cell<usize>,
+}
+
+impl Selection for Counting<'_> {
+    fn validate(&self) -> crate::Result<()> {
+        self.inner.validate()
+    }
+    fn selects(&self, s: &Sphere) -> bool {
+        self.tests.set(self.tests.get() + 1);
+        self.inner.selects(s)
+    }
+    fn classify_box(&self, b: &Aabb, mask: u8) -> (Relation, u8) {
+        self.inner.classify_box(b, mask)
+    }
+    fn bounds(&self) -> Option<Aabb> {
+        None
+    }
+}
+
+#[test]
+fn frustum_reports_inside_subtrees_without_testing_spheres() {
+    let t = clustered_tree(5, 400);
+    let tests = Cell::new(0);
+    // A camera far back, looking at the whole world: everything is Inside.
+    let view = Mat4::look_at_rh(vec3(32.0, 32.0, 400.0), vec3(32.0, 32.0, 32.0), Vec3::Y);
+    let proj = Mat4::perspective_rh(1.0, 1.0, 1.0, 1000.0);
+    let q = Counting {
+        inner: Frustum::from_view_projection(proj * view).unwrap(),
+        tests: &tests,
+    };
+    let mut n = 0;
+    let _ = t.visit(&q, |_, _, _| {
+        n += 1;
+        std::ops::ControlFlow::Continue(())
+    });
+    assert_eq!((n, tests.get()), (400, 0));
+    // A narrow one: fewer sphere tests than objects, and the same answer as a scan.
+    let view = Mat4::look_at_rh(vec3(10.0, 10.0, 40.0), vec3(10.0, 10.0, 10.0), Vec3::Y);
+    let proj = Mat4::perspective_rh(0.3, 1.0, 1.0, 100.0);
+    let fr = Frustum::from_view_projection(proj * view).unwrap();
+    let q = Counting {
+        inner: fr,
+        tests: &tests,
+    };
+    tests.set(0);
+    let mut got = Vec::new();
+    let _ = t.visit(&q, |h, _, _| {
+        got.push(h);
+        std::ops::ControlFlow::Continue(())
+    });
+    let mut want = Vec::new();
+    t.for_each(|h, s, _| {
+        if fr.selects(s) {
+            want.push(h)
+        }
+    });
+    got.sort();
+    want.sort();
+    assert_eq!(got, want);
+    assert!(
+        !got.is_empty() && tests.get() < 400,
+        "{} tests",
+        tests.get()
+    );
+}
+
+#[test]
+fn clear_memory_and_stats() {
+    let mut t = clustered_tree(1, 500);
+    let m = t.memory_bytes();
+    assert!(m > 500 * std::mem::size_of::<Sphere>(), "{m}");
+    let s = t.stats();
+    assert_eq!(s.objects, 500);
+    assert!(s.leaves > 50 && s.nodes > s.leaves);
+    t.clear();
+    t.validate().unwrap();
+    assert!(t.memory_bytes() < m / 4);
+    assert_eq!(t.stats().nodes, 1);
+}

@@ -1,0 +1,38 @@
+//! The generic oracle run on `LooseKdTree` variants that the one-line entry in
+//! `tests/oracle/main.rs` (density 0.5, default depth cap) does not cover: other
+//! densities, a depth cap low enough that capped nodes hold many spheres, and an
+//! `R_max` far below the scenes' radii (nearly everything attached at the root).
+
+#[path = "oracle/harness.rs"]
+mod harness;
+
+use harness::{run, SceneParams, ALL_SCENES};
+use proxima::broad::LooseKdTree;
+
+const OPS: usize = 3000;
+
+fn suite(make: impl Fn(&SceneParams) -> LooseKdTree<u64> + Copy) {
+    for scene in ALL_SCENES {
+        run(scene, 11, OPS, make);
+    }
+}
+
+#[test]
+fn density_0_1() {
+    suite(|p| LooseKdTree::new(p.world, p.r_max, 0.1).unwrap());
+}
+
+#[test]
+fn density_1_0() {
+    suite(|p| LooseKdTree::new(p.world, p.r_max, 1.0).unwrap());
+}
+
+#[test]
+fn depth_cap_3() {
+    suite(|p| LooseKdTree::with_max_depth(p.world, p.r_max, 0.5, 3).unwrap());
+}
+
+#[test]
+fn r_max_tiny() {
+    suite(|p| LooseKdTree::new(p.world, p.r_max * 0.01, 0.7).unwrap());
+}

@@ -1,0 +1,9 @@
+//! Exactness tests of `proxima::narrow::triangles_intersect` against two
+//! references: `reference` (exact predicates, a different decomposition) and
+//! `carath` (integer arithmetic, Carathéodory; grid inputs only).
+
+mod carath;
+mod cases;
+mod random;
+mod reference;
+mod sym;

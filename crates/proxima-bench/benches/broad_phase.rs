@@ -3,7 +3,7 @@
 //! W1 at 10k and 100k, W2 and W3 at 100k. Pair counts are checked equal across
 //! structures on every frame (a mismatch panics).
 //!
-//! `cargo bench -p proxima-bench --features criterion --bench broad_phase [-- FILTER]`
+//! `cargo bench -p proxima-bench --bench broad_phase [-- FILTER]`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use proxima_bench::registry::entries;

@@ -3,6 +3,7 @@
 //! This file only parses arguments and dispatches; each command lives in its own
 //! module, and the broad-phase indices they run are listed once in [`indices`].
 
+mod collide;
 mod default_run;
 mod indices;
 mod replay;
@@ -27,6 +28,15 @@ struct Cli {
 enum Command {
     /// Replay a recorded scene trace against one index or all of them.
     Replay(replay::Args),
+    /// Mesh-vs-mesh contacts (exact triangle pairs) with the seed's cost counters:
+    /// `collide A B [--bv aabb|kdop14|kdop18|kdop26|obb|sphere] [--split mean|median|sah]
+    /// [--first] [--poses FILE] [--stats] [--time] [--leaf N] [--rotation auto|refit|conservative]`.
+    #[command(disable_help_flag = true)]
+    Collide {
+        /// Meshes and options, parsed by the command itself.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -34,5 +44,6 @@ fn main() -> ExitCode {
     match cli.command {
         None => default_run::main(),
         Some(Command::Replay(args)) => replay::main(&args),
+        Some(Command::Collide { args }) => ExitCode::from(collide::main(&args) as u8),
     }
 }

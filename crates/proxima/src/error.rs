@@ -33,6 +33,9 @@ pub enum Error {
     /// A triangle mesh failed validation (no triangles, index out of range,
     /// non-finite vertex).
     InvalidMesh(String),
+    /// A pose that is not a rigid motion: non-finite, or a matrix that is not a
+    /// rotation (orthonormal with determinant +1, within a small tolerance).
+    InvalidPose(String),
     /// A mesh file could not be read (I/O failure, unknown format).
     Io {
         /// The file's path as given.
@@ -87,6 +90,7 @@ impl fmt::Display for Error {
             Error::InvalidParameter(msg) => write!(f, "invalid parameter: {msg}"),
             Error::Invalid(msg) => write!(f, "invariant violated: {msg}"),
             Error::InvalidMesh(msg) => write!(f, "invalid mesh: {msg}"),
+            Error::InvalidPose(msg) => write!(f, "invalid pose: {msg}"),
             Error::Io { file, msg } => write!(f, "{file}: {msg}"),
             Error::Parse { file, at, msg } => write!(f, "{file}: {at}: {msg}"),
         }

@@ -1,0 +1,134 @@
+//! Bounding volumes for mesh BVHs, behind one trait (seed 003).
+//!
+//! The seed compares spheres, AABBs, OBBs and k-DOPs through the cost model
+//! `T = Nv*Cv + Np*Cp + Nu*Cu`: a tighter volume lowers `Nv` (volume tests) and `Np`
+//! (triangle tests), a cheaper one lowers `Cv`, and one that is cheap to update under
+//! motion lowers `Nu*Cu`. Every volume here implements [`BoundingVolume`], so a
+//! [`Bvh`](crate::narrow::Bvh) and the collision queries are written once.
+//!
+//! Two families:
+//! - *axis-aligned* volumes ([`Aabb`](crate::geom::Aabb), [`Kdop`]): their slab
+//!   normals are fixed in the world. A translation shifts the slab intervals (no node
+//!   update); a rotation needs the moving tree refit ([`BoundingVolume::AXIS_ALIGNED`]).
+//! - *oriented* volumes ([`Obb`], [`Sphere`](crate::geom::Sphere)): the test takes
+//!   the relative pose directly.
+//!
+//! Robustness: volumes are fitted from `f32` points, and the triangle test receives
+//! `f32` points transformed by the pose, so every overlap test accepts an absolute
+//! `slack` that covers the rounding of projections, transforms and shifts (computed
+//! per query from the coordinate magnitudes). The tests are therefore conservative:
+//! they never reject a pair whose triangles intersect.
+
+mod aabb;
+mod kdop;
+mod obb;
+mod sphere;
+
+pub use kdop::{Kdop, Kdop14, Kdop18, Kdop26};
+pub use obb::Obb;
+
+use crate::geom::Ray;
+use glam::{Affine3A, Vec3};
+use std::fmt::Debug;
+
+/// A bounding volume usable in a [`Bvh`](crate::narrow::Bvh).
+///
+/// "Moving frame" below is the frame of the mesh that carries a pose (the first
+/// mesh of a collision query); the pose maps it into the frame of the other mesh.
+pub trait BoundingVolume: Copy + Debug + Send + Sync + 'static {
+    /// A relative pose prepared once per query for [`BoundingVolume::overlaps`]
+    /// (for k-DOPs: the per-slab shifts `dot(axis_i, t)`; for OBBs: the matrix).
+    type Motion: Copy + Debug;
+
+    /// Short name (`"aabb"`, `"kdop18"`, `"obb"`, `"sphere"`).
+    const NAME: &'static str;
+
+    /// True for volumes whose slab normals are fixed in the world (AABB, k-DOPs):
+    /// [`BoundingVolume::motion`] then reads only the translation of the pose, and a
+    /// rotated pose is handled by refitting the moving tree (seed 003) or by
+    /// [`BoundingVolume::transformed`].
+    const AXIS_ALIGNED: bool;
+
+    /// The volume fitted to a non-empty set of points. O(points).
+    fn from_points(points: &[Vec3]) -> Self;
+
+    /// The volume fitted to a non-empty set of triangles. Defaults to the fit of
+    /// their corners; [`Obb`] overrides it with the triangle-area covariance.
+    fn from_triangles(triangles: &[[Vec3; 3]]) -> Self {
+        let pts: Vec<Vec3> = triangles.iter().flatten().copied().collect();
+        Self::from_points(&pts)
+    }
+
+    /// A volume containing both (exact for AABB and k-DOPs, conservative otherwise).
+    fn merge(&self, other: &Self) -> Self;
+
+    /// Refit to new points after deformation: same as [`BoundingVolume::from_points`]
+    /// except that an [`Obb`] keeps its axes (so a refit is O(points), no PCA).
+    fn refit_points(&self, points: &[Vec3]) -> Self {
+        Self::from_points(points)
+    }
+
+    /// Refit of an internal node from its refitted children: [`BoundingVolume::merge`]
+    /// by default; an [`Obb`] keeps its own axes and bounds the children's corners.
+    fn refit_parent(&self, left: &Self, right: &Self) -> Self {
+        left.merge(right)
+    }
+
+    /// A volume containing this one moved by `pose` (a rigid motion). Exact for
+    /// [`Obb`] and spheres; for axis-aligned volumes a conservative bound (the
+    /// k-DOP of the rotated AABB part), the seed's refit being the exact alternative.
+    fn transformed(&self, pose: &Affine3A) -> Self;
+
+    /// Prepares `pose` (moving frame → other frame) and the rounding `slack`.
+    fn motion(pose: &Affine3A, slack: f32) -> Self::Motion;
+
+    /// Closed overlap of `self` (in the moving frame, moved by `motion`) with `other`
+    /// (in the fixed frame), enlarged by the motion's slack. Conservative.
+    fn overlaps(&self, motion: &Self::Motion, other: &Self) -> bool;
+
+    /// The volume grown by `slack` on every side (k-DOPs: every slab interval).
+    fn inflated(&self, slack: f32) -> Self;
+
+    /// Closed overlap of two volumes in the same frame, without slack (the caller
+    /// has [`inflated`](BoundingVolume::inflated) one of them).
+    fn overlaps_fixed(&self, other: &Self) -> bool {
+        self.overlaps(&Self::motion(&Affine3A::IDENTITY, 0.0), other)
+    }
+
+    /// A size measure used to decide which tree to descend (the larger volume).
+    /// Invariant under rigid motion for oriented volumes.
+    fn size(&self) -> f32;
+
+    /// The entry parameter of `ray` into the volume enlarged by `slack`, clipped to
+    /// `[0, ray.max_t]`, or `None` if the ray misses it. Conservative.
+    fn ray_entry(&self, ray: &Ray, slack: f32) -> Option<f32>;
+}
+
+/// Clips the ray interval `[t0, t1]` by the slab `lo <= o + t*d <= hi` (one axis of
+/// a k-DOP or a box). Returns false if the interval becomes empty. A zero `d` keeps
+/// the interval iff the origin is inside the slab.
+#[inline]
+pub(crate) fn clip_slab(o: f32, d: f32, lo: f32, hi: f32, t0: &mut f32, t1: &mut f32) -> bool {
+    if d == 0.0 {
+        return o >= lo && o <= hi;
+    }
+    let inv = 1.0 / d;
+    let (mut ta, mut tb) = ((lo - o) * inv, (hi - o) * inv);
+    if ta > tb {
+        std::mem::swap(&mut ta, &mut tb);
+    }
+    // Widen by a relative epsilon: the division rounds.
+    let w = (ta.abs().max(tb.abs())) * (4.0 * f32::EPSILON);
+    *t0 = t0.max(ta - w);
+    *t1 = t1.min(tb + w);
+    *t0 <= *t1
+}
+
+/// The rounding slack of one collision query: an absolute distance that covers the
+/// rounding of projections, pose transforms and interval shifts for coordinates of
+/// magnitude at most `scale` (a bound on `|x| + |y| + |z|` of every point involved)
+/// and of a rotation matrix whose `RᵀR` differs from identity by at most `dev`.
+#[inline]
+pub(crate) fn slack_for(scale: f32, dev: f32) -> f32 {
+    scale * (64.0 * f32::EPSILON + 4.0 * dev)
+}

@@ -1,0 +1,27 @@
+//! Bounding-volume hierarchies over triangle meshes (seed 003).
+//!
+//! - [`tree`](Bvh): the flat node array and its accessors;
+//! - `build.rs`: top-down binary build, split at the mean or the median of the
+//!   triangle centroids (the seed's two rules) or by a binned surface-area heuristic;
+//! - `refit.rs`: bottom-up refit for deformed vertices, and the exact world-frame
+//!   refit of a rotated tree (the seed's rotation update);
+//! - `traverse.rs`: the simultaneous descent of two trees (seed 003, Fig. 2);
+//! - `collide.rs`: mesh–mesh collision of two posed meshes with the cost counters;
+//! - `ray.rs`: ray and segment casts;
+//! - `validate.rs`: the structural invariants.
+
+mod build;
+mod collide;
+mod ray;
+mod refit;
+mod traverse;
+mod tree;
+mod validate;
+
+pub use build::{BuildOptions, SplitRule};
+pub use collide::{
+    check_pose, collide_all, collide_first, Collider, Contacts, CostCounters, FirstContact,
+    RotationUpdate,
+};
+pub use ray::RayHit;
+pub use tree::{Bvh, Node};

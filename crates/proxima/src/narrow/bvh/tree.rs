@@ -1,0 +1,121 @@
+//! The BVH: one flat array of small nodes, children by index (Box2D / parry style).
+
+use super::build::BuildOptions;
+use crate::narrow::bv::BoundingVolume;
+
+/// One node: its volume and either its triangle range (leaf) or its right child.
+///
+/// Nodes are stored in depth-first pre-order, so the left child of internal node `i`
+/// is `i + 1` and every child has a larger index than its parent (a reverse sweep is
+/// a bottom-up pass).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Node<BV> {
+    /// The bounding volume of every triangle below the node.
+    pub bv: BV,
+    /// Leaf: first position in the BVH's triangle order. Internal: right child.
+    pub(crate) start: u32,
+    /// Leaf: number of triangles (`>= 1`). Internal: `0`.
+    pub(crate) count: u32,
+}
+
+impl<BV> Node<BV> {
+    /// True for a leaf.
+    #[inline]
+    pub fn is_leaf(&self) -> bool {
+        self.count != 0
+    }
+
+    /// For an internal node at index `i`: its two children.
+    #[inline]
+    pub fn children(&self, i: u32) -> (u32, u32) {
+        (i + 1, self.start)
+    }
+
+    /// For a leaf: the range of positions in [`Bvh::triangle_order`].
+    #[inline]
+    pub fn triangle_range(&self) -> std::ops::Range<usize> {
+        self.start as usize..(self.start + self.count) as usize
+    }
+}
+
+/// A binary bounding-volume hierarchy over the triangles of a
+/// [`TriMesh`](crate::narrow::TriMesh), generic over the [`BoundingVolume`].
+///
+/// The tree keeps its own copy of the triangles' vertex indices, permuted so that
+/// each leaf covers a contiguous range, and reads vertex *positions* from the mesh
+/// at query time: after [`TriMesh::set_vertices`](crate::narrow::TriMesh::set_vertices)
+/// call [`Bvh::refit`]. Built by [`Bvh::build`] (seed 003: top-down, binary).
+#[derive(Clone, Debug)]
+pub struct Bvh<BV> {
+    pub(crate) nodes: Vec<Node<BV>>,
+    /// Vertex-index triples in leaf order.
+    pub(crate) tris: Vec<[u32; 3]>,
+    /// `ids[k]`: index in the mesh of `tris[k]`.
+    pub(crate) ids: Vec<u32>,
+    pub(crate) n_vertices: usize,
+    /// Max over vertices of `|x| + |y| + |z|` (for the rounding slack).
+    pub(crate) coord_bound: f32,
+    pub(crate) options: BuildOptions,
+}
+
+impl<BV: BoundingVolume> Bvh<BV> {
+    /// The nodes, root first (pre-order).
+    pub fn nodes(&self) -> &[Node<BV>] {
+        &self.nodes
+    }
+
+    /// The root volume.
+    pub fn root(&self) -> &BV {
+        &self.nodes[0].bv
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// Mesh triangle index at each leaf-order position.
+    pub fn triangle_order(&self) -> &[u32] {
+        &self.ids
+    }
+
+    /// The options the tree was built with.
+    pub fn options(&self) -> BuildOptions {
+        self.options
+    }
+
+    /// Depth of the tree (a single leaf has depth 1). O(nodes).
+    pub fn depth(&self) -> usize {
+        let mut depth = vec![0usize; self.nodes.len()];
+        depth[0] = 1;
+        let mut best = 1;
+        for (i, n) in self.nodes.iter().enumerate() {
+            if !n.is_leaf() {
+                let (l, r) = n.children(i as u32);
+                depth[l as usize] = depth[i] + 1;
+                depth[r as usize] = depth[i] + 1;
+                best = best.max(depth[i] + 1);
+            }
+        }
+        best
+    }
+
+    /// Checks that `vertices` can be used with this tree (same count as at build).
+    pub(crate) fn check_vertices(&self, n: usize) -> crate::Result<()> {
+        if n != self.n_vertices {
+            return Err(crate::Error::InvalidMesh(format!(
+                "BVH was built over {} vertices, mesh has {n}",
+                self.n_vertices
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Max over `vertices` of `|x| + |y| + |z|`.
+pub(crate) fn coord_bound(vertices: &[glam::Vec3]) -> f32 {
+    vertices
+        .iter()
+        .map(|v| v.abs().element_sum())
+        .fold(0.0f32, f32::max)
+}

@@ -5,7 +5,10 @@
 //! and [`with_index`] instantiates it for the named index. Adding an index is one
 //! entry in the `registry!` invocation at the bottom of this file.
 
-use proxima::broad::{BruteForce, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex};
+use proxima::broad::{
+    loose_kd, BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex,
+    UniformGrid2d,
+};
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::Vec3;
 
@@ -108,8 +111,10 @@ pub const BRUTE: &str = "brute";
 
 registry! {
     "brute" => |_| Ok(BruteForce::<u64>::new()),
-    "loose-kd" => |h| LooseKdTree::<u64>::new(h.world, h.r_max, 0.25),
+    "loose-kd" => |h| LooseKdTree::<u64>::new(h.world, h.r_max, loose_kd::DEFAULT_DENSITY),
     "octree" => |h| LinearOctree::<u64>::new(h.world, OctreeConfig::default()),
+    "grid2d" => |h| UniformGrid2d::<u64>::new(h.world, h.r_max),
+    "hashgrid" => |h| HashGrid::<u64>::new(h.r_max),
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@
 mod harness;
 
 use harness::{run, SceneParams, ALL_SCENES};
-use proxima::broad::LooseKdTree;
+use proxima::broad::{loose_kd, LooseKdTree};
 
 const OPS: usize = 3000;
 
@@ -20,6 +20,11 @@ fn suite(make: impl Fn(&SceneParams) -> LooseKdTree<u64> + Copy) {
 #[test]
 fn density_0_1() {
     suite(|p| LooseKdTree::new(p.world, p.r_max, 0.1).unwrap());
+}
+
+#[test]
+fn density_default() {
+    suite(|p| LooseKdTree::new(p.world, p.r_max, loose_kd::DEFAULT_DENSITY).unwrap());
 }
 
 #[test]

@@ -25,6 +25,13 @@ pub trait Selection {
     /// A box that every selected sphere intersects, if the query has one; indices
     /// use it for one-comparison pruning and for cell ranges. May be infinite.
     fn bounds(&self) -> Option<Aabb>;
+
+    /// The query as a [`Ray`], if it is one. Grids use it to walk the cells along
+    /// the ray instead of the ray's (possibly unbounded) bounding box; every other
+    /// index may ignore it.
+    fn as_ray(&self) -> Option<&Ray> {
+        None
+    }
 }
 
 impl Selection for Sphere {
@@ -122,5 +129,8 @@ impl Selection for Ray {
             )
         };
         Some(Aabb::new(self.origin.min(end), self.origin.max(end)))
+    }
+    fn as_ray(&self) -> Option<&Ray> {
+        Some(self)
     }
 }

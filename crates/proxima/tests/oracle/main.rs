@@ -4,7 +4,7 @@
 mod harness;
 
 use harness::{run, SceneParams, ALL_SCENES};
-use proxima::broad::{BruteForce, LooseKdTree};
+use proxima::broad::{BruteForce, HashGrid, LooseKdTree, UniformGrid2d};
 
 /// Number of random operations per scene and seed.
 const OPS: usize = 6000;
@@ -37,3 +37,8 @@ oracle_suite!(loose_kd, |p: &SceneParams| LooseKdTree::new(
     p.world, p.r_max, 0.5
 )
 .unwrap());
+oracle_suite!(grid2d, |p: &SceneParams| UniformGrid2d::new(
+    p.world, p.r_max
+)
+.unwrap());
+oracle_suite!(hash_grid, |p: &SceneParams| HashGrid::new(p.r_max).unwrap());

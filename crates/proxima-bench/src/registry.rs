@@ -4,7 +4,9 @@
 use crate::parry::ParryBvh;
 use crate::structure::{Indexed, Structure};
 use crate::workloads::Scene;
-use proxima::broad::{BruteForce, LinearOctree, LooseKdTree, OctreeConfig};
+use proxima::broad::{
+    loose_kd, BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, UniformGrid2d,
+};
 
 /// One benchmarked structure: a name and how to make it empty for a scene.
 pub struct Entry {
@@ -60,12 +62,17 @@ macro_rules! proxima {
 pub fn entries() -> Vec<Entry> {
     vec![
         proxima!("BruteForce", quadratic, |_| Ok(BruteForce::new())),
-        // Density 0.25 as in the CLI (1.0 measured 4x slower per W1 frame at 10k).
-        proxima!("LooseKdTree", |s| LooseKdTree::new(s.world, s.r_max, 0.25)),
+        proxima!("LooseKdTree", |s| LooseKdTree::new(
+            s.world,
+            s.r_max,
+            loose_kd::DEFAULT_DENSITY
+        )),
         proxima!("LinearOctree", |s| LinearOctree::new(
             s.world,
             OctreeConfig::default()
         )),
+        proxima!("UniformGrid2d", |s| UniformGrid2d::new(s.world, s.r_max)),
+        proxima!("HashGrid", |s| HashGrid::new(s.r_max)),
         Entry {
             name: PARRY,
             quadratic: false,

@@ -5,7 +5,7 @@
 //!
 //! `cargo bench -p proxima-bench --bench broad_phase [-- FILTER]`
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode};
 use proxima_bench::registry::entries;
 use proxima_bench::run::PairLedger;
 use proxima_bench::workloads::{Kind, Workload};
@@ -19,6 +19,8 @@ fn workload_group(c: &mut Criterion, kind: Kind, n: usize) {
     // Few, long samples: one frame at 100k is tens of milliseconds, and the whole
     // bench must finish in a few minutes on a shared 2-core machine.
     group.sample_size(10);
+    // Flat: every sample runs the same number of frames (frames are long).
+    group.sampling_mode(SamplingMode::Flat);
     group.warm_up_time(Duration::from_millis(500));
     group.measurement_time(Duration::from_secs(if n > 20_000 { 4 } else { 2 }));
     let mut ledger = PairLedger::new();

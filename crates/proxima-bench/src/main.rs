@@ -1,19 +1,20 @@
-//! `proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only A,B] [--json]`
+//! `proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only A,B] [--clock cpu|wall] [--json]`
 //!
 //! Runs one standard workload through every structure (Proxima's indices and the
 //! peers) and prints a table: build time, median update and pair-finding time per
 //! frame, pairs per frame (checked equal for every structure on every frame),
 //! bytes per object and frame time relative to parry3d. O(n²) structures are
-//! skipped above 20k objects.
+//! skipped above 20k objects. Times are the running thread's CPU time by default
+//! (`--clock wall` for elapsed time): this machine is shared.
 
 use proxima_bench::registry::{self, QUADRATIC_LIMIT};
 use proxima_bench::report;
-use proxima_bench::run::measure_all;
+use proxima_bench::run::{measure_all, Clock};
 use proxima_bench::workloads::Kind;
 use std::process::ExitCode;
 
 const USAGE: &str =
-    "usage: proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--json]";
+    "usage: proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--json]";
 
 struct Args {
     kind: Kind,
@@ -21,6 +22,7 @@ struct Args {
     frames: usize,
     seed: u64,
     only: Vec<String>,
+    clock: Clock,
     json: bool,
 }
 
@@ -33,6 +35,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         frames: 20,
         seed: 1,
         only: Vec::new(),
+        clock: Clock::ThreadCpu,
         json: false,
     };
     while let Some(flag) = it.next() {
@@ -47,6 +50,13 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                     .filter(|s| !s.is_empty())
                     .map(String::from)
                     .collect()
+            }
+            "--clock" => {
+                a.clock = match value("--clock")?.as_str() {
+                    "cpu" => Clock::ThreadCpu,
+                    "wall" => Clock::Wall,
+                    other => return Err(format!("--clock takes cpu or wall, not {other:?}")),
+                }
             }
             "--json" => a.json = true,
             "-h" | "--help" => return Err(String::new()),
@@ -88,21 +98,34 @@ fn main() -> ExitCode {
         .filter(|e| !e.runs_on(args.n))
         .map(|e| e.name)
         .collect();
-    let results = measure_all(&entries, args.kind, args.n, args.seed, args.frames, |e| {
-        eprintln!("running {} ...", e.name)
-    });
+    let results = measure_all(
+        &entries,
+        args.kind,
+        args.n,
+        args.seed,
+        args.frames,
+        args.clock,
+        |e| eprintln!("running {} ...", e.name),
+    );
     if args.json {
         print!(
             "{}",
-            report::json(args.kind.name(), args.seed, args.frames, &results)
+            report::json(
+                args.kind.name(),
+                args.seed,
+                args.frames,
+                args.clock,
+                &results
+            )
         );
     } else {
         println!(
-            "{} n={} frames={} seed={} (medians per frame; pair counts checked equal on every frame)",
+            "{} n={} frames={} seed={} clock={} (medians per frame; pair counts checked equal on every frame)",
             args.kind.name(),
             args.n,
             args.frames,
-            args.seed
+            args.seed,
+            args.clock.name()
         );
         print!("{}", report::table(&results));
         if !skipped.is_empty() {

@@ -1,7 +1,7 @@
 //! Formats measurements as a text table or JSON (hand-written: no serde needed).
 
 use crate::registry::PARRY;
-use crate::run::Measurement;
+use crate::run::{Clock, Measurement};
 use std::fmt::Write;
 use std::time::Duration;
 
@@ -52,7 +52,7 @@ pub fn table(all: &[Measurement]) -> String {
 }
 
 /// The same data as a JSON array of objects.
-pub fn json(workload: &str, seed: u64, frames: usize, all: &[Measurement]) -> String {
+pub fn json(workload: &str, seed: u64, frames: usize, clock: Clock, all: &[Measurement]) -> String {
     let mut out = String::from("[\n");
     for (i, m) in all.iter().enumerate() {
         let ratio = ratio_to_parry(m, all)
@@ -60,12 +60,13 @@ pub fn json(workload: &str, seed: u64, frames: usize, all: &[Measurement]) -> St
             .unwrap_or_else(|| "null".into());
         let _ = write!(
             out,
-            "  {{\"workload\": \"{workload}\", \"n\": {}, \"seed\": {seed}, \"frames\": {frames}, \
+            "  {{\"workload\": \"{workload}\", \"n\": {}, \"seed\": {seed}, \"frames\": {frames}, \"clock\": \"{}\", \
              \"structure\": \"{}\", \"peer\": {}, \"build_ms\": {:.4}, \
              \"update_ms_median\": {:.4}, \"pairs_ms_median\": {:.4}, \"frame_ms_median\": {:.4}, \
              \"pairs_per_frame\": {:.1}, \"memory_bytes\": {}, \"bytes_per_object\": {:.2}, \
              \"frame_ratio_to_parry3d\": {ratio}}}",
             m.n,
+            clock.name(),
             m.name,
             m.peer,
             ms(m.build),

@@ -6,6 +6,43 @@ use crate::structure::Structure;
 use crate::workloads::{Kind, Workload};
 use std::time::{Duration, Instant};
 
+/// What the timings measure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clock {
+    /// Elapsed real time (what criterion measures).
+    Wall,
+    /// CPU time of the running thread: excludes time the thread spent
+    /// descheduled, so it stays meaningful on a shared, loaded machine. The
+    /// benchmarked code is single-threaded, so on an idle machine both agree.
+    ThreadCpu,
+}
+
+impl Clock {
+    /// `wall` or `cpu`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Clock::Wall => "wall",
+            Clock::ThreadCpu => "cpu",
+        }
+    }
+
+    /// Runs `f` and returns its result and how long it took on this clock.
+    pub fn time<R>(self, f: impl FnOnce() -> R) -> (R, Duration) {
+        match self {
+            Clock::Wall => {
+                let t = Instant::now();
+                let r = f();
+                (r, t.elapsed())
+            }
+            Clock::ThreadCpu => {
+                let t = cpu_time::ThreadTime::now();
+                let r = f();
+                (r, t.elapsed())
+            }
+        }
+    }
+}
+
 /// The pair count of every frame, as first reported; later structures must agree.
 ///
 /// Frame `f` is the state after `f` calls of [`Workload::step`] on a fresh
@@ -122,13 +159,12 @@ pub fn measure(
     n: usize,
     seed: u64,
     frames: usize,
+    clock: Clock,
     ledger: &mut PairLedger,
 ) -> Measurement {
     let mut w = Workload::new(kind, n, seed);
     let mut s: Box<dyn Structure> = (entry.make)(&w.scene());
-    let t = Instant::now();
-    s.build(&w.spheres);
-    let build = t.elapsed();
+    let ((), build) = clock.time(|| s.build(&w.spheres));
     let mut m = Measurement {
         name: entry.name,
         peer: entry.peer,
@@ -141,12 +177,10 @@ pub fn measure(
     };
     for _ in 0..frames {
         w.step();
-        let t = Instant::now();
-        s.update(&w.spheres);
-        m.update.push(t.elapsed());
-        let t = Instant::now();
-        let count = s.count_pairs();
-        m.pairs.push(t.elapsed());
+        let ((), t) = clock.time(|| s.update(&w.spheres));
+        m.update.push(t);
+        let (count, t) = clock.time(|| s.count_pairs());
+        m.pairs.push(t);
         ledger.check(w.frame(), entry.name, count);
         m.pair_total += count;
     }
@@ -162,6 +196,7 @@ pub fn measure_all(
     n: usize,
     seed: u64,
     frames: usize,
+    clock: Clock,
     mut progress: impl FnMut(&Entry),
 ) -> Vec<Measurement> {
     let mut ledger = PairLedger::new();
@@ -170,7 +205,7 @@ pub fn measure_all(
         .filter(|e| e.runs_on(n))
         .map(|e| {
             progress(e);
-            measure(e, kind, n, seed, frames, &mut ledger)
+            measure(e, kind, n, seed, frames, clock, &mut ledger)
         })
         .collect()
 }

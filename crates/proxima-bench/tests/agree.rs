@@ -2,7 +2,7 @@
 //! version of every workload (a few frames). Light on purpose: runs in CI.
 
 use proxima_bench::registry::entries;
-use proxima_bench::run::{measure, PairLedger};
+use proxima_bench::run::{measure, Clock, PairLedger};
 use proxima_bench::workloads::{Kind, Workload};
 
 /// Pair count by the definition (exact closed test on every pair).
@@ -38,7 +38,7 @@ fn every_structure_counts_the_brute_force_pairs() {
         assert!(all.len() >= 2);
         for e in &all {
             // Panics on the first frame whose count differs.
-            let m = measure(e, kind, n, 11, FRAMES, &mut ledger);
+            let m = measure(e, kind, n, 11, FRAMES, Clock::Wall, &mut ledger);
             assert_eq!(m.pair_total, total, "{} on {kind:?}", e.name);
             assert!(m.memory > 0);
         }

@@ -1,0 +1,211 @@
+//! Runs a workload through structures, timing build, update and pair finding, and
+//! checking that every structure finds the same number of pairs on every frame.
+
+use crate::registry::Entry;
+use crate::structure::Structure;
+use crate::workloads::{Kind, Workload};
+use std::time::{Duration, Instant};
+
+/// What the timings measure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clock {
+    /// Elapsed real time (what criterion measures).
+    Wall,
+    /// CPU time of the running thread: excludes time the thread spent
+    /// descheduled, so it stays meaningful on a shared, loaded machine. The
+    /// benchmarked code is single-threaded, so on an idle machine both agree.
+    ThreadCpu,
+}
+
+impl Clock {
+    /// `wall` or `cpu`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Clock::Wall => "wall",
+            Clock::ThreadCpu => "cpu",
+        }
+    }
+
+    /// Runs `f` and returns its result and how long it took on this clock.
+    pub fn time<R>(self, f: impl FnOnce() -> R) -> (R, Duration) {
+        match self {
+            Clock::Wall => {
+                let t = Instant::now();
+                let r = f();
+                (r, t.elapsed())
+            }
+            Clock::ThreadCpu => {
+                let t = cpu_time::ThreadTime::now();
+                let r = f();
+                (r, t.elapsed())
+            }
+        }
+    }
+}
+
+/// The pair count of every frame, as first reported; later structures must agree.
+///
+/// Frame `f` is the state after `f` calls of [`Workload::step`] on a fresh
+/// workload of the same kind, size and seed, so counts are comparable across
+/// structures however many frames each one runs (criterion runs a different
+/// number of iterations for each).
+#[derive(Debug, Default)]
+pub struct PairLedger {
+    counts: Vec<Option<(u64, &'static str)>>,
+}
+
+impl PairLedger {
+    /// An empty ledger.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Records `count` for `frame` reported by `who`, or panics if another
+    /// structure reported a different count for the same frame.
+    pub fn check(&mut self, frame: u64, who: &'static str, count: u64) {
+        let f = frame as usize;
+        if self.counts.len() <= f {
+            self.counts.resize(f + 1, None);
+        }
+        match self.counts[f] {
+            None => self.counts[f] = Some((count, who)),
+            Some((c, first)) => assert!(
+                c == count,
+                "PAIR COUNT MISMATCH at frame {frame}: {first} found {c} pairs, {who} found {count}"
+            ),
+        }
+    }
+
+    /// The recorded count of a frame, if any.
+    pub fn get(&self, frame: u64) -> Option<u64> {
+        self.counts
+            .get(frame as usize)
+            .copied()
+            .flatten()
+            .map(|(c, _)| c)
+    }
+}
+
+/// What one structure measured on one workload.
+#[derive(Clone, Debug)]
+pub struct Measurement {
+    /// Structure name.
+    pub name: &'static str,
+    /// Whether this is a peer crate.
+    pub peer: bool,
+    /// Time to insert every object into the empty structure.
+    pub build: Duration,
+    /// Per-frame update times (move every object).
+    pub update: Vec<Duration>,
+    /// Per-frame pair-finding times.
+    pub pairs: Vec<Duration>,
+    /// Total pairs over all frames.
+    pub pair_total: u64,
+    /// `memory_bytes()` after the last frame.
+    pub memory: usize,
+    /// Number of objects.
+    pub n: usize,
+}
+
+/// Median of a list of durations (zero when empty).
+pub fn median(d: &[Duration]) -> Duration {
+    if d.is_empty() {
+        return Duration::ZERO;
+    }
+    let mut v = d.to_vec();
+    v.sort();
+    v[v.len() / 2]
+}
+
+impl Measurement {
+    /// Median update time per frame.
+    pub fn update_median(&self) -> Duration {
+        median(&self.update)
+    }
+
+    /// Median pair-finding time per frame.
+    pub fn pairs_median(&self) -> Duration {
+        median(&self.pairs)
+    }
+
+    /// Median of per-frame (update + pairs) times.
+    pub fn frame_median(&self) -> Duration {
+        let f: Vec<_> = self
+            .update
+            .iter()
+            .zip(&self.pairs)
+            .map(|(u, p)| *u + *p)
+            .collect();
+        median(&f)
+    }
+
+    /// Mean pairs per frame.
+    pub fn pairs_per_frame(&self) -> f64 {
+        self.pair_total as f64 / self.pairs.len().max(1) as f64
+    }
+
+    /// Bytes per stored object.
+    pub fn bytes_per_object(&self) -> f64 {
+        self.memory as f64 / self.n.max(1) as f64
+    }
+}
+
+/// Runs `frames` frames of workload (`kind`, `n`, `seed`) through one structure:
+/// build (timed), then per frame: step the workload (not timed), update every
+/// object (timed), count pairs (timed, checked against `ledger`).
+pub fn measure(
+    entry: &Entry,
+    kind: Kind,
+    n: usize,
+    seed: u64,
+    frames: usize,
+    clock: Clock,
+    ledger: &mut PairLedger,
+) -> Measurement {
+    let mut w = Workload::new(kind, n, seed);
+    let mut s: Box<dyn Structure> = (entry.make)(&w.scene());
+    let ((), build) = clock.time(|| s.build(&w.spheres));
+    let mut m = Measurement {
+        name: entry.name,
+        peer: entry.peer,
+        build,
+        update: Vec::with_capacity(frames),
+        pairs: Vec::with_capacity(frames),
+        pair_total: 0,
+        memory: 0,
+        n,
+    };
+    for _ in 0..frames {
+        w.step();
+        let ((), t) = clock.time(|| s.update(&w.spheres));
+        m.update.push(t);
+        let (count, t) = clock.time(|| s.count_pairs());
+        m.pairs.push(t);
+        ledger.check(w.frame(), entry.name, count);
+        m.pair_total += count;
+    }
+    m.memory = s.memory_bytes();
+    m
+}
+
+/// Runs every entry affordable at `n` (see [`Entry::runs_on`]) on the same
+/// workload, in order, with one shared ledger: panics on any pair-count mismatch.
+pub fn measure_all(
+    entries: &[Entry],
+    kind: Kind,
+    n: usize,
+    seed: u64,
+    frames: usize,
+    clock: Clock,
+    mut progress: impl FnMut(&Entry),
+) -> Vec<Measurement> {
+    let mut ledger = PairLedger::new();
+    entries
+        .iter()
+        .filter(|e| e.runs_on(n))
+        .map(|e| {
+            progress(e);
+            measure(e, kind, n, seed, frames, clock, &mut ledger)
+        })
+        .collect()
+}

@@ -497,13 +497,40 @@ fn fmt_ms(v: f64) -> String {
     }
 }
 
-/// A projected triangle: depth along the view, 2D corners, colour, intersecting.
-type Tri2 = (f32, [(f32, f32); 3], Rgba, bool);
+/// A projected triangle: depth along the view, 2D corners, colour.
+type Tri2 = (f32, [(f32, f32); 3], Rgba);
 
-/// Two meshes, `a` moved by `pose`, in an orthographic view from direction
-/// `(1, -1.5, 1)` (flat shading, painter's order); the triangles listed in `pairs`
-/// (indices into `a` and `b`) are drawn red, and outlined on top so that hidden
-/// ones still show.
+/// Cuts `t` into 4 at its edge midpoints until no edge is longer than `limit`
+/// (at most `levels` times).
+fn subdivide(t: [Vec3; 3], limit: f32, levels: u32, out: &mut Vec<[Vec3; 3]>) {
+    let longest = (t[0] - t[1])
+        .length()
+        .max((t[1] - t[2]).length())
+        .max((t[2] - t[0]).length());
+    if longest <= limit || levels == 0 {
+        out.push(t);
+        return;
+    }
+    let m = [
+        (t[0] + t[1]) * 0.5,
+        (t[1] + t[2]) * 0.5,
+        (t[2] + t[0]) * 0.5,
+    ];
+    for piece in [
+        [t[0], m[0], m[2]],
+        [m[0], t[1], m[1]],
+        [m[2], m[1], t[2]],
+        [m[0], m[1], m[2]],
+    ] {
+        subdivide(piece, limit, levels - 1, out);
+    }
+}
+
+/// Two meshes, `a` moved by `pose`, in an orthographic view from above at
+/// `(1, -1.5, 1)` (flat shading, painter's order, farthest first), framed on `a`
+/// and the part of `b` near it. Triangles listed in `pairs` (indices into `a` and `b`)
+/// are filled red (those of `b` lighter, since they may be large) and outlined on
+/// top, so that hidden ones still show.
 pub fn meshes(
     title: &str,
     a: &TriMesh,
@@ -512,11 +539,10 @@ pub fn meshes(
     pairs: &[(u32, u32)],
 ) -> Canvas {
     let (w, h) = (900.0f32, 800.0f32);
-    let view_dir = Vec3::new(1.0, -1.5, 1.0).normalize();
-    let up = Vec3::Z;
-    let right = view_dir.cross(up).normalize();
-    let upv = right.cross(view_dir).normalize();
-    let light = (-view_dir + upv * 0.6 + right * 0.3).normalize();
+    let eye = Vec3::new(1.0, -1.5, 1.0).normalize();
+    let right = Vec3::Z.cross(eye).normalize();
+    let upv = eye.cross(right).normalize();
+    let light = (eye + upv * 0.5 + right * 0.3).normalize();
     let mut hit_a = vec![false; a.len()];
     let mut hit_b = vec![false; b.len()];
     for &(i, j) in pairs {
@@ -527,39 +553,117 @@ pub fn meshes(
             *x = true;
         }
     }
-    let mut tris: Vec<Tri2> = Vec::with_capacity(a.len() + b.len());
-    let mut lo = (f32::INFINITY, f32::INFINITY);
-    let mut hi = (f32::NEG_INFINITY, f32::NEG_INFINITY);
-    let col_a = Rgba::rgb(90, 140, 210);
+    let col_a = Rgba::rgb(70, 130, 220);
     let col_b = Rgba::rgb(215, 195, 150);
-    let red = Rgba::rgb(230, 30, 30);
-    for (mesh, posed, base, hits) in [(a, true, col_a, &hit_a), (b, false, col_b, &hit_b)] {
-        for (i, &hit) in hits.iter().enumerate() {
-            let mut t = mesh.triangle(i);
-            if posed {
-                for p in &mut t {
-                    *p = pose.transform_point3(*p);
-                }
-            }
-            let n = (t[1] - t[0]).cross(t[2] - t[0]);
-            let shade = if n.length_squared() > 0.0 {
-                0.35 + 0.65 * n.normalize().dot(light).abs()
-            } else {
-                0.35
-            };
-            let p2 = t.map(|p| (p.dot(right), p.dot(upv)));
-            for p in &p2 {
-                lo = (lo.0.min(p.0), lo.1.min(p.1));
-                hi = (hi.0.max(p.0), hi.1.max(p.1));
-            }
-            let depth = (t[0] + t[1] + t[2]).dot(view_dir) / 3.0;
-            let colour = if hit { red } else { base }.shade(shade);
-            tris.push((depth, p2, colour, hit));
+    let red = Rgba::rgb(235, 20, 20);
+    let pink = Rgba::rgb(250, 150, 140);
+    // Only the part of `b` near `a` is drawn (a room around a robot would hide it):
+    // triangles whose box meets `a`'s box grown by half its size, and every hit.
+    let posed: Vec<[Vec3; 3]> = (0..a.len())
+        .map(|i| a.triangle(i).map(|p| pose.transform_point3(p)))
+        .collect();
+    let mut abox = Aabb::EMPTY;
+    for p in posed.iter().flatten() {
+        abox = abox.union(&Aabb::new(*p, *p));
+    }
+    let size = abox.extent().max_element().max(1e-6);
+    let near = abox.grown(size * 0.5);
+    let shown: Vec<(usize, [Vec3; 3])> = (0..b.len())
+        .map(|i| (i, b.triangle(i)))
+        .filter(|(i, t)| {
+            let bb = Aabb::new(t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+            hit_b[*i] || bb.intersects_aabb(&near)
+        })
+        .collect();
+    let project = |p: Vec3| (p.dot(right), p.dot(upv));
+    // Frame: `a` with room around it (three times its size), or everything drawn
+    // if that is smaller.
+    let mut union = (
+        (f32::INFINITY, f32::INFINITY),
+        (f32::NEG_INFINITY, f32::NEG_INFINITY),
+    );
+    let grow = |r: &mut ((f32, f32), (f32, f32)), q: (f32, f32)| {
+        r.0 = (r.0 .0.min(q.0), r.0 .1.min(q.1));
+        r.1 = (r.1 .0.max(q.0), r.1 .1.max(q.1));
+    };
+    let mut around = union;
+    for p in posed.iter().flatten() {
+        grow(&mut around, project(*p));
+    }
+    for p in posed.iter().chain(shown.iter().map(|(_, t)| t)).flatten() {
+        grow(&mut union, project(*p));
+    }
+    let pad = (around.1 .0 - around.0 .0)
+        .max(around.1 .1 - around.0 .1)
+        .max(1e-6);
+    let around = (
+        (around.0 .0 - pad, around.0 .1 - pad),
+        (around.1 .0 + pad, around.1 .1 + pad),
+    );
+    let area = |r: ((f32, f32), (f32, f32))| (r.1 .0 - r.0 .0) * (r.1 .1 - r.0 .1);
+    let (lo, hi) = if area(union) <= area(around) {
+        union
+    } else {
+        around
+    };
+    // Widen the frame to the drawing area's aspect ratio.
+    let (top, bottom, side) = (60.0, 70.0, 30.0);
+    let (aw, ah) = (w - 2.0 * side, h - top - bottom);
+    let (fw, fh) = ((hi.0 - lo.0).max(1e-6), (hi.1 - lo.1).max(1e-6));
+    let (lo, hi) = if fw / fh < aw / ah {
+        let extra = (fh * aw / ah - fw) / 2.0;
+        ((lo.0 - extra, lo.1), (hi.0 + extra, hi.1))
+    } else {
+        let extra = (fw * ah / aw - fh) / 2.0;
+        ((lo.0, lo.1 - extra), (hi.0, hi.1 + extra))
+    };
+    // Painter's order fails when a huge triangle (a floor) is sorted as one piece,
+    // so triangles are cut into pieces no larger than a tenth of `a`, and only
+    // pieces inside the frame are kept.
+    let limit = size / 10.0;
+    let in_frame = |t: &[Vec3; 3]| {
+        let q = t.map(project);
+        let (x0, x1) = (
+            q[0].0.min(q[1].0).min(q[2].0),
+            q[0].0.max(q[1].0).max(q[2].0),
+        );
+        let (y0, y1) = (
+            q[0].1.min(q[1].1).min(q[2].1),
+            q[0].1.max(q[1].1).max(q[2].1),
+        );
+        x1 >= lo.0 && x0 <= hi.0 && y1 >= lo.1 && y0 <= hi.1
+    };
+    let mut tris: Vec<Tri2> = Vec::new();
+    let mut outlines = Vec::new();
+    let mut pieces = Vec::new();
+    let items = posed
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (t, hit_a[i], col_a, red))
+        .chain(shown.iter().map(|(i, t)| (t, hit_b[*i], col_b, pink)));
+    for (t, hit, base, hit_col) in items {
+        if !in_frame(t) {
+            continue;
+        }
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        let shade = if n.length_squared() > 0.0 {
+            0.45 + 0.55 * n.normalize().dot(light).abs()
+        } else {
+            0.45
+        };
+        let colour = if hit { hit_col } else { base }.shade(shade);
+        if hit {
+            outlines.push(t.map(project));
+        }
+        pieces.clear();
+        subdivide(*t, limit, 6, &mut pieces);
+        for p in pieces.iter().filter(|p| in_frame(p)) {
+            // Distance from the eye grows as the dot with `eye` falls.
+            let depth = -(p[0] + p[1] + p[2]).dot(eye) / 3.0;
+            tris.push((depth, p.map(project), colour));
         }
     }
-    let mut c = Canvas::new(w as u32, h as u32);
-    c.text(30.0, 28.0, 2, title, BLACK, Anchor::Start);
-    let (top, bottom, side) = (60.0, 70.0, 30.0);
+    let shown_b = shown.len();
     let span = ((hi.0 - lo.0) / (w - 2.0 * side)).max((hi.1 - lo.1) / (h - top - bottom));
     let scale = if span > 0.0 && span.is_finite() {
         1.0 / span
@@ -569,18 +673,24 @@ pub fn meshes(
     let ox = side + ((w - 2.0 * side) - (hi.0 - lo.0) * scale) / 2.0;
     let oy = top + ((h - top - bottom) - (hi.1 - lo.1) * scale) / 2.0;
     let map = |p: (f32, f32)| (ox + (p.0 - lo.0) * scale, oy + (hi.1 - p.1) * scale);
-    // Farthest first: larger depth along the view direction is farther away.
+    let mut c = Canvas::new(w as u32, h as u32);
     tris.sort_by(|x, y| y.0.total_cmp(&x.0));
-    for (_, p, col, _) in &tris {
+    for (_, p, col) in &tris {
         let pts = p.iter().map(|q| map(*q)).collect();
-        c.polygon(pts, Some(*col), Some((col.shade(0.85), 0.5)));
+        // Stroked in their own colour: hides the seams between pieces.
+        c.polygon(pts, Some(*col), Some((*col, 0.8)));
     }
-    for (_, p, _, hit) in &tris {
-        if *hit {
-            let pts = p.iter().map(|q| map(*q)).collect();
-            c.polygon(pts, None, Some((red, 1.5)));
-        }
+    for p in &outlines {
+        let pts = p.iter().map(|q| map(*q)).collect();
+        c.polygon(pts, None, Some((red, 1.5)));
     }
+    // Clip to the drawing area; title and legend go on white bands.
+    let white = Some(Rgba::rgb(255, 255, 255));
+    c.rect(0.0, 0.0, w, top - 10.0, white, None);
+    c.rect(0.0, h - bottom + 10.0, w, bottom, white, None);
+    c.rect(0.0, 0.0, side, h, white, None);
+    c.rect(w - side, 0.0, side, h, white, None);
+    c.text(30.0, 28.0, 2, title, BLACK, Anchor::Start);
     let y = h - 40.0;
     c.rect(side, y - 12.0, 14.0, 14.0, Some(col_a), None);
     c.text(
@@ -596,17 +706,18 @@ pub fn meshes(
         side + 322.0,
         y,
         1,
-        &format!("B: {} triangles", b.len()),
+        &format!("B: {} triangles, the {shown_b} near A shown", b.len()),
         BLACK,
         Anchor::Start,
     );
     c.rect(side, y + 8.0, 14.0, 14.0, Some(red), None);
+    c.rect(side + 16.0, y + 8.0, 14.0, 14.0, Some(pink), None);
     c.text(
-        side + 22.0,
+        side + 38.0,
         y + 20.0,
         1,
         &format!(
-            "intersecting triangles: {} pairs, {} of A, {} of B (outlined even when hidden)",
+            "intersecting triangles of A and B: {} pairs, {} of A, {} of B (outlined even if hidden)",
             pairs.len(),
             hit_a.iter().filter(|x| **x).count(),
             hit_b.iter().filter(|x| **x).count()

@@ -316,7 +316,10 @@ fn run(args: &Args) -> Result<ExitCode, String> {
             None => unreachable!("names come from the registry"),
         };
         bar.finish();
-        if !terminal {
+        if terminal {
+            // indicatif leaves the cursor at the end of the finished bar.
+            eprintln!();
+        } else {
             eprintln!(
                 "{name:>9}: {frames} frames ({} with pairs) in {:.2} s",
                 row.searched(),

@@ -59,13 +59,13 @@ fn parse_args(args: &[String]) -> Result<Args, String> {
         let mut value = |name: &str| {
             it.next()
                 .cloned()
-                .ok_or_else(|| format!("{name} needs a value\n{USAGE}"))
+                .ok_or_else(|| format!("{name} needs a value ({USAGE})"))
         };
         match arg.as_str() {
             "--bv" => {
                 let v = value("--bv")?;
                 if !["aabb", "kdop14", "kdop18", "kdop26", "obb", "sphere"].contains(&v.as_str()) {
-                    return Err(format!("unknown bounding volume '{v}'\n{USAGE}"));
+                    return Err(format!("unknown bounding volume '{v}' ({USAGE})"));
                 }
                 out.bv = v;
             }
@@ -74,7 +74,7 @@ fn parse_args(args: &[String]) -> Result<Args, String> {
                     "mean" => SplitRule::Mean,
                     "median" => SplitRule::Median,
                     "sah" => SplitRule::Sah,
-                    v => return Err(format!("unknown split rule '{v}'\n{USAGE}")),
+                    v => return Err(format!("unknown split rule '{v}' ({USAGE})")),
                 }
             }
             "--leaf" => {
@@ -89,19 +89,19 @@ fn parse_args(args: &[String]) -> Result<Args, String> {
                     "auto" => RotationUpdate::Auto,
                     "refit" => RotationUpdate::Refit,
                     "conservative" => RotationUpdate::Conservative,
-                    v => return Err(format!("unknown rotation update '{v}'\n{USAGE}")),
+                    v => return Err(format!("unknown rotation update '{v}' ({USAGE})")),
                 }
             }
             "--poses" => out.poses = Some(value("--poses")?),
             "--first" => out.first = true,
             "--stats" => out.stats = true,
             "--time" => out.time = true,
-            s if s.starts_with("--") => return Err(format!("unknown option '{s}'\n{USAGE}")),
+            s if s.starts_with("--") => return Err(format!("unknown option '{s}' ({USAGE})")),
             s => files.push(s.to_string()),
         }
     }
     if files.len() != 2 {
-        return Err(format!("expected two mesh files\n{USAGE}"));
+        return Err(format!("expected two mesh files ({USAGE})"));
     }
     out.b = files.pop().unwrap_or_default();
     out.a = files.pop().unwrap_or_default();

@@ -6,8 +6,7 @@
 //! entry in the `registry!` invocation at the bottom of this file.
 
 use proxima::broad::{
-    loose_kd, BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex,
-    UniformGrid2d,
+    BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex, UniformGrid2d,
 };
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::Vec3;
@@ -109,10 +108,23 @@ macro_rules! registry {
 /// Name of the oracle; every other index is compared with it.
 pub const BRUTE: &str = "brute";
 
+/// The loose k-d tree as every command builds it (pictures draw this one too).
+pub fn loose_kd(h: &SceneHint) -> proxima::Result<LooseKdTree<u64>> {
+    LooseKdTree::new(h.world, h.r_max, KD_DENSITY)
+}
+
+/// Density `d` of the loose k-d tree (design §2.1): the library's measured default.
+pub const KD_DENSITY: f32 = proxima::broad::loose_kd::DEFAULT_DENSITY;
+
+/// The linear octree as every command builds it (pictures draw this one too).
+pub fn octree(h: &SceneHint) -> proxima::Result<LinearOctree<u64>> {
+    LinearOctree::new(h.world, OctreeConfig::default())
+}
+
 registry! {
     "brute" => |_| Ok(BruteForce::<u64>::new()),
-    "loose-kd" => |h| LooseKdTree::<u64>::new(h.world, h.r_max, loose_kd::DEFAULT_DENSITY),
-    "octree" => |h| LinearOctree::<u64>::new(h.world, OctreeConfig::default()),
+    "loose-kd" => loose_kd,
+    "octree" => octree,
     "grid2d" => |h| UniformGrid2d::<u64>::new(h.world, h.r_max),
     "hashgrid" => |h| HashGrid::<u64>::new(h.r_max),
 }

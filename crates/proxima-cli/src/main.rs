@@ -4,28 +4,41 @@
 //! module, and the broad-phase indices they run are listed once in [`indices`].
 
 mod collide;
-mod default_run;
+mod demo;
+mod draw;
 mod indices;
+mod pictures;
+mod render;
 mod replay;
 mod scene;
 mod trace;
 
+use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Spatial queries and collision detection for dynamic 3D scenes.
 ///
-/// Without a command: runs the default scene (moving spheres) through every
-/// broad-phase index and prints a comparison table.
+/// Without a command: `proxima demo` (its options may be given directly).
 #[derive(Parser, Debug)]
-#[command(name = "proxima", version, about)]
+#[command(
+    name = "proxima",
+    version,
+    about,
+    args_conflicts_with_subcommands = true
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    #[command(flatten)]
+    demo: demo::Args,
 }
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// The main job: moving spheres through every broad-phase index, a table and
+    /// pictures of the partitions (the default).
+    Demo(demo::Args),
     /// Replay a recorded scene trace against one index or all of them.
     Replay(replay::Args),
     /// Mesh-vs-mesh contacts (exact triangle pairs) with the seed's cost counters:
@@ -37,13 +50,33 @@ enum Command {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
     },
+    /// Pictures: the partitions of a trace's end state, or two meshes and their
+    /// intersecting triangles (`--collide A B [--pose ...]`).
+    Render(render::Args),
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => match e.kind() {
+            ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => e.exit(),
+            _ => {
+                // One line, never clap's multi-line report.
+                let text = e.to_string();
+                let first = text.lines().next().unwrap_or("bad arguments");
+                let first = first.strip_prefix("error: ").unwrap_or(first);
+                eprintln!("proxima: {first} (see proxima --help)");
+                return ExitCode::from(2);
+            }
+        },
+    };
     match cli.command {
-        None => default_run::main(),
+        None => demo::main(&cli.demo),
+        Some(Command::Demo(args)) => demo::main(&args),
         Some(Command::Replay(args)) => replay::main(&args),
         Some(Command::Collide { args }) => ExitCode::from(collide::main(&args) as u8),
+        Some(Command::Render(args)) => render::main(&args),
     }
 }

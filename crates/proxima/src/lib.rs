@@ -24,3 +24,8 @@ pub mod narrow;
 
 pub use error::{Error, FileLocation, Result};
 pub use glam;
+
+/// The root README's examples, compiled and run as doctests (`cargo test`).
+#[doc = include_str!("../../../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -7,7 +7,7 @@
 //! creation, placing and swap-removing objects),
 //! `update.rs` (removal and moves with climbing), `query.rs` (selection queries and
 //! the front-to-back ray search), `pairs.rs` (node-vs-node self collision),
-//! `validate.rs`, `stats.rs`.
+//! `validate.rs`, `stats.rs`, `visit.rs` (read-only node walk for pictures).
 
 mod insert;
 mod node;
@@ -16,11 +16,13 @@ mod query;
 mod stats;
 mod update;
 mod validate;
+mod visit;
 
 #[cfg(test)]
 mod tests;
 
 pub use stats::{KdStats, Placement};
+pub use visit::KdNodeView;
 
 use crate::arena::{Arena, Handle, Pool};
 use crate::broad::{RayHit, Selection, SpatialIndex};

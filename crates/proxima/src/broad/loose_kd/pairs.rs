@@ -398,10 +398,25 @@ impl<T> LooseKdTree<T> {
                 }
             }
         }
+        let same_axis = node.axis as usize == axis;
         for side in 0..2 {
             let c = node.child[side];
             if c == NIL {
                 continue;
+            }
+            if same_axis {
+                // A split on the border's own axis: every carried item ends below
+                // the border's ceiling, so narrowing it to the negative child drops
+                // nothing, and the positive child's items all start above its floor,
+                // so if that floor is past the ceiling none reaches back (the
+                // argument of `gather`, mirrored). Either way no copy is needed.
+                if side == 0 {
+                    self.walk(c, active, border, buf, f)?;
+                    continue;
+                }
+                if self.pos_floor(node) > ceil {
+                    continue;
+                }
             }
             if self.worth_filtering(c) {
                 self.filter_into_child(n, side, active, end, buf);

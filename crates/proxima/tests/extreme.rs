@@ -432,3 +432,31 @@ fn aabb_center_does_not_overflow() {
     let o = LinearOctree::<u32>::new(b, OctreeConfig::default());
     assert!(o.is_ok());
 }
+
+/// Fuzz (index_ops, timeout): a segment from x = 1e20 to x = -32 over a hash grid
+/// holding an object at x = -3e38. Every strip's `t` rounded to `max_t = 1`, so the
+/// walk's stop test never fired and it went on for ~1e9 strips. The walk now stops
+/// at the (padded) cell of the ray's end.
+#[test]
+fn hash_grid_far_segment_strip_loop() {
+    let mut g = HashGrid::with_cell_size(1.0).unwrap();
+    let mut b = BruteForce::new();
+    for (k, s) in [
+        Sphere::new(vec3(-3e38, -8192.0, -32.0), 16.5),
+        Sphere::new(vec3(-28.75, -30.0, -32.0), 15.375),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        g.insert(s, k as u32).unwrap();
+        b.insert(s, k as u32).unwrap();
+    }
+    let seg = Segment::new(vec3(1e20, -32.0, -32.0), vec3(-32.0, -32.0, -32.0));
+    let n = |h: Vec<proxima::broad::RayHit>| h.len();
+    assert_eq!(
+        n(g.segment_hits(&seg).unwrap()),
+        n(b.segment_hits(&seg).unwrap())
+    );
+    let r = Ray::with_max_t(vec3(1e20, -32.0, -32.0), vec3(-1e20, 0.0, 0.0), 1.0);
+    assert_eq!(n(g.ray_hits(&r).unwrap()), n(b.ray_hits(&r).unwrap()));
+}

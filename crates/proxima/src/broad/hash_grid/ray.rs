@@ -103,17 +103,25 @@ impl<T> HashGrid<T> {
             })
         };
         // Length of the walk, against the cost of scanning every occupied cell.
-        let walk = start.map(|(i, _)| {
-            let end = if ray.max_t.is_finite() {
-                k.coord(ray.at(ray.max_t)[a])
-            } else if forward {
-                LIMIT
+        // The last strip: the cell of the ray's end, padded in the direction of
+        // travel (far from the origin `o + d t` rounds by up to its magnitude times
+        // epsilon, and so do the strips' `t`s, which can then all round to `max_t`:
+        // the walk must stop at this cell, not wait for a `t` beyond `max_t`).
+        let end = if ray.max_t.is_finite() {
+            let v = ray.at(ray.max_t)[a];
+            let pad = (o[a].abs() + (d[a] * ray.max_t).abs()) * RAY_PAD;
+            if forward {
+                k.coord(v + pad)
             } else {
-                -LIMIT
-            };
-            let end = end.clamp(occ.lo[a], occ.hi[a]);
-            (end as i64 - i as i64).unsigned_abs() + 1
-        });
+                k.coord(v - pad)
+            }
+        } else if forward {
+            LIMIT
+        } else {
+            -LIMIT
+        };
+        let end = end.clamp(occ.lo[a], occ.hi[a]);
+        let walk = start.map(|(i, _)| (end as i64 - i as i64).unsigned_abs() + 1);
         let Some((mut i, mut ta)) = start.filter(|_| {
             walk.unwrap_or(u64::MAX).saturating_mul(LOOKUPS_PER_STRIP) <= self.map.len() as u64
         }) else {
@@ -228,6 +236,9 @@ impl<T> HashGrid<T> {
             step(Step::StripDone { t_done: ta })?;
             let Some(next_line) = end_line else { break };
             if tb >= ray.max_t && line_t(next_line) > ray.max_t {
+                break;
+            }
+            if i == end {
                 break;
             }
             i = if forward { i + 1 } else { i - 1 };

@@ -460,3 +460,45 @@ fn hash_grid_far_segment_strip_loop() {
     let r = Ray::with_max_t(vec3(1e20, -32.0, -32.0), vec3(-1e20, 0.0, 0.0), 1.0);
     assert_eq!(n(g.ray_hits(&r).unwrap()), n(b.ray_hits(&r).unwrap()));
 }
+
+/// Fuzz (index_ops): a frustum with a zero-normal plane `0·p - 4.75 >= 0` (from a
+/// degenerate matrix: everywhere outside). The box test culled every node while
+/// the sphere test kept spheres of radius > 4.75 (it compared with `-r`, not with
+/// `-r |n|`). Both now scale the radius/extent by `|n|`.
+#[test]
+fn frustum_zero_normal_plane_consistent() {
+    use proxima::geom::Plane;
+    let mut planes = [Plane::new(Vec3::X, 1e3); 6];
+    planes[5] = Plane::new(Vec3::ZERO, -4.75);
+    let f = Frustum::from_planes(planes);
+    let big = Sphere::new(vec3(-32.0, -32.0, 27.0), 29.5);
+    assert_eq!(
+        overlap::frustum_sphere(&f, &big),
+        proxima::geom::Relation::Outside
+    );
+    let mut kd =
+        LooseKdTree::new(Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0)), 2.0, 0.5).unwrap();
+    let mut b = BruteForce::new();
+    for (k, s) in [Sphere::new(vec3(-8192.0, 0.0, -32.0), 0.0), big]
+        .into_iter()
+        .enumerate()
+    {
+        kd.insert(s, k as u32).unwrap();
+        b.insert(s, k as u32).unwrap();
+    }
+    assert!(b.frustum_hits(&f).unwrap().is_empty());
+    assert!(kd.frustum_hits(&f).unwrap().is_empty());
+    // A plane with a scaled normal is the same half-space.
+    planes[5] = Plane::new(vec3(0.0, 0.0, 2.0), 0.0);
+    let f = Frustum::from_planes(planes);
+    let touching = Sphere::new(vec3(0.0, 0.0, -1.0), 1.0);
+    assert_ne!(
+        overlap::frustum_sphere(&f, &touching),
+        proxima::geom::Relation::Outside
+    );
+    let out = Sphere::new(vec3(0.0, 0.0, -1.5), 1.0);
+    assert_eq!(
+        overlap::frustum_sphere(&f, &out),
+        proxima::geom::Relation::Outside
+    );
+}

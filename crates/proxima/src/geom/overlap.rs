@@ -170,15 +170,21 @@ fn signed_distance(p: &crate::geom::Plane, c: [f64; 3]) -> f64 {
 }
 
 /// Frustum–sphere, per plane: `Outside` if the sphere is entirely on the outer side of
-/// some plane (`distance < -r`), `Inside` if it is at least `r` inside every plane,
+/// some plane (`n·c + d < -r |n|`; `|n| = 1` for normalized planes), `Inside` if it is at least `r` inside every plane,
 /// else `Intersecting`. A sphere exactly touching a plane from outside is not culled.
 /// In `f64`; a NaN distance (only from a NaN plane) never culls.
 #[inline]
 pub fn frustum_sphere(f: &Frustum, s: &Sphere) -> Relation {
     let mut rel = Relation::Inside;
-    let (c, r) = (d3(s.center), s.radius as f64);
+    let c = d3(s.center);
     for p in &f.planes {
         let d = signed_distance(p, c);
+        // The radius in the plane's units: `r |n|`. For the unit normals of
+        // `from_view_projection` this is `r`; for a zero normal (a degenerate
+        // matrix: the plane is everywhere inside or everywhere outside) it is 0,
+        // consistent with `frustum_aabb`, whose box extent also scales with |n|.
+        let n = d3(p.normal);
+        let r = s.radius as f64 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         if d < -r {
             return Relation::Outside;
         }

@@ -480,6 +480,9 @@ pub fn run(data: &[u8]) {
             }
             10 => {
                 let f = frustum(&mut b);
+                if debug {
+                    eprintln!("  {f:?}");
+                }
                 same("frustum query", &idx, |i| i.frustum_ids(&f));
             }
             11 | 12 => {

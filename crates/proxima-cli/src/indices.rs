@@ -28,6 +28,9 @@ pub struct SceneHint {
     pub max_live: usize,
 }
 
+/// Largest coordinate of a hinted world box.
+const WORLD_LIMIT: f32 = 1e30;
+
 /// Quantile of the radii used for [`SceneHint::r_max`].
 const R_QUANTILE: f64 = 0.99;
 
@@ -49,8 +52,16 @@ impl SceneHint {
         if radii.is_empty() {
             world = Aabb::new(Vec3::ZERO, Vec3::ONE);
         }
-        // Pad thin axes symmetrically to a unit extent.
-        let pad = ((Vec3::ONE - world.extent()) * 0.5).max(Vec3::ZERO);
+        // Keep the world within ±WORLD_LIMIT (objects beyond it are still stored:
+        // every index accepts centres outside its world), so that constructors
+        // never meet a box whose extent overflows.
+        let lim = Vec3::splat(WORLD_LIMIT);
+        world = Aabb::new(world.min.clamp(-lim, lim), world.max.clamp(-lim, lim));
+        // Pad thin axes symmetrically to a unit extent, or 1e-3 of the magnitude far
+        // from the origin (where a unit would be lost to rounding).
+        let magnitude = world.min.abs().max(world.max.abs());
+        let want = Vec3::ONE.max(magnitude * 1e-3);
+        let pad = ((want - world.extent()) * 0.5).max(Vec3::ZERO);
         world = Aabb::new(world.min - pad, world.max + pad);
         let (r_max, r_largest) = if radii.is_empty() {
             (1.0, 1.0)

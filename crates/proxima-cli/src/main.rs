@@ -55,7 +55,34 @@ enum Command {
     Render(render::Args),
 }
 
+/// The last line of defence: a panic (a bug: bad input is reported as an error
+/// with exit code 2) prints one line naming where it happened, not a backtrace
+/// banner, and exits with code 101.
+fn install_panic_hook() {
+    std::panic::set_hook(Box::new(|info| {
+        let payload = info.payload();
+        let msg = payload
+            .downcast_ref::<&str>()
+            .copied()
+            .or_else(|| payload.downcast_ref::<String>().map(String::as_str))
+            .unwrap_or("panic");
+        let at = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        let first = msg.lines().next().unwrap_or("");
+        if first.contains("Broken pipe") {
+            // The reader closed stdout early (`proxima demo | head`): stop quietly
+            // with the status a shell reports for SIGPIPE.
+            std::process::exit(141);
+        }
+        eprintln!("proxima: internal error (please report): {first}{at}");
+        std::process::exit(101);
+    }));
+}
+
 fn main() -> ExitCode {
+    install_panic_hook();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => match e.kind() {

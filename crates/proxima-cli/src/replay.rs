@@ -270,7 +270,7 @@ pub fn disagreement(runs: &[Run]) -> Option<(usize, &Run, &Run)> {
         .map(|(i, r)| (i, r, brute))
 }
 
-fn run_one(idx: &str, hint: &SceneHint, trace: &Trace) -> Result<Run, String> {
+pub fn run_one(idx: &str, hint: &SceneHint, trace: &Trace) -> Result<Run, String> {
     match indices::with_index(idx, hint, &mut Replay { trace }) {
         None => Err(format!("unknown index '{idx}'")),
         Some(Err(e)) => Err(format!("index {idx} rejects the scene: {e}")),

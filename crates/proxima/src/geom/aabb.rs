@@ -36,10 +36,10 @@ impl Aabb {
         }
     }
 
-    /// Centre point.
+    /// Centre point (halves first, so it does not overflow for any finite box).
     #[inline]
     pub fn center(&self) -> Vec3 {
-        (self.min + self.max) * 0.5
+        self.min * 0.5 + self.max * 0.5
     }
 
     /// `max - min`.
@@ -48,10 +48,11 @@ impl Aabb {
         self.max - self.min
     }
 
-    /// Half of [`Aabb::extent`].
+    /// Half of [`Aabb::extent`] (halves first, so it does not overflow for any
+    /// finite box).
     #[inline]
     pub fn half_extent(&self) -> Vec3 {
-        (self.max - self.min) * 0.5
+        self.max * 0.5 - self.min * 0.5
     }
 
     /// The box grown by `d` on every side.

@@ -6,17 +6,49 @@
 use crate::geom::{Aabb, Frustum, Ray, Relation, Sphere};
 use glam::Vec3;
 
-/// Sphere–sphere: `|c1 - c2|² <= (r1 + r2)²`.
+// The sphere tests are exact: whether `|p - q| <= r1 + r2` is decided for the
+// real numbers the `f32` inputs denote, at every magnitude. A fast `f64`
+// evaluation decides unless the two sides agree to 1e-12 relative; then an exact
+// evaluation (error-free transformations, see `exact.rs`) decides. In `f64` no
+// square of a finite `f32` overflows (x² <= 1.2e77), so there is no `inf <= inf`.
+// The other tests (rays, frustums) compute in `f64`: no overflow for finite
+// inputs, rounding ~1e-16 relative.
+
 #[inline]
-pub fn sphere_sphere(a: &Sphere, b: &Sphere) -> bool {
-    let rs = a.radius + b.radius;
-    (a.center - b.center).length_squared() <= rs * rs
+fn d3(v: Vec3) -> [f64; 3] {
+    [v.x as f64, v.y as f64, v.z as f64]
 }
 
-/// Sphere–AABB: the squared distance from the centre to the box is at most `r²`.
+/// Exactly: `|p - q| <= r1 + r2` (radii non-negative).
+#[inline]
+pub(crate) fn within(p: Vec3, q: Vec3, r1: f32, r2: f32) -> bool {
+    let (a, b) = (d3(p), d3(q));
+    let d2: f64 = (0..3).map(|i| (a[i] - b[i]) * (a[i] - b[i])).sum();
+    let rs = r1 as f64 + r2 as f64;
+    let rs2 = rs * rs;
+    // The fast path's relative error is below 1e-15 (a few roundings of 2^-53).
+    let margin = 1e-12 * (d2 + rs2);
+    if d2 < rs2 - margin {
+        true
+    } else if d2 > rs2 + margin {
+        false
+    } else {
+        super::exact::within(a, b, r1 as f64, r2 as f64)
+    }
+}
+
+/// Sphere–sphere: `|c1 - c2| <= r1 + r2`, decided exactly (see the module).
+#[inline]
+pub fn sphere_sphere(a: &Sphere, b: &Sphere) -> bool {
+    within(a.center, b.center, a.radius, b.radius)
+}
+
+/// Sphere–AABB: the distance from the centre to the box (its closest point) is at
+/// most `r`, decided exactly.
 #[inline]
 pub fn sphere_aabb(s: &Sphere, b: &Aabb) -> bool {
-    b.distance_squared_to_point(s.center) <= s.radius * s.radius
+    let q = s.center.clamp(b.min, b.max);
+    within(s.center, q, s.radius, 0.0)
 }
 
 /// AABB–AABB: the intervals overlap on all three axes.
@@ -29,28 +61,32 @@ pub fn aabb_aabb(a: &Aabb, b: &Aabb) -> bool {
 /// the ray is in the closed ball, or `None`. An origin inside the ball gives `0`.
 ///
 /// Uses the closest-approach form (distance of the centre from the line computed
-/// from the projected point, not from `b² - ac`) to avoid cancellation for long rays.
+/// from the projected point, not from `b² - ac`) to avoid cancellation for long
+/// rays, in `f64`; the returned `t` is that value rounded to `f32`, and it is that
+/// rounded value which is compared with `max_t`.
 #[inline]
 pub fn ray_sphere(ray: &Ray, s: &Sphere) -> Option<f32> {
-    let m = ray.origin - s.center;
-    let r2 = s.radius * s.radius;
-    let c = m.length_squared() - r2;
-    if c <= 0.0 {
+    let (o, c, d) = (d3(ray.origin), d3(s.center), d3(ray.dir));
+    let m = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let r = s.radius as f64;
+    let r2 = r * r;
+    if within(ray.origin, s.center, s.radius, 0.0) {
         return Some(0.0);
     }
-    let b = m.dot(ray.dir);
+    let b = dot(m, d);
     if b >= 0.0 {
         // Outside and not approaching: the distance only grows with t.
         return None;
     }
-    let a = ray.dir.length_squared();
+    let a = dot(d, d);
     let tc = -b / a;
-    let closest = m + ray.dir * tc;
-    let h2 = r2 - closest.length_squared();
+    let closest = [m[0] + d[0] * tc, m[1] + d[1] * tc, m[2] + d[2] * tc];
+    let h2 = r2 - dot(closest, closest);
     if h2 < 0.0 {
         return None;
     }
-    let t = (tc - (h2 / a).sqrt()).max(0.0);
+    let t = ((tc - (h2 / a).sqrt()).max(0.0)) as f32;
     (t <= ray.max_t).then_some(t)
 }
 
@@ -58,15 +94,17 @@ pub fn ray_sphere(ray: &Ray, s: &Sphere) -> Option<f32> {
 /// ray inside the closed box, clipped to `[0, ray.max_t]`, or `None`.
 ///
 /// A zero direction component is handled explicitly (the ray is inside that slab for
-/// all `t` or for none), so no `0 * ∞` NaN arises.
+/// all `t` or for none), so no `0 * ∞` NaN arises. Computed in `f64` (a tiny
+/// direction component gives a huge but finite inverse); the interval is rounded
+/// outward to `f32`, so it always contains the exact one.
 #[inline]
 pub fn ray_aabb(ray: &Ray, b: &Aabb) -> Option<(f32, f32)> {
-    let mut t0 = 0.0f32;
-    let mut t1 = ray.max_t;
+    let mut t0 = 0.0f64;
+    let mut t1 = ray.max_t as f64;
     for axis in 0..3 {
-        let o = ray.origin[axis];
-        let d = ray.dir[axis];
-        let (lo, hi) = (b.min[axis], b.max[axis]);
+        let o = ray.origin[axis] as f64;
+        let d = ray.dir[axis] as f64;
+        let (lo, hi) = (b.min[axis] as f64, b.max[axis] as f64);
         if d == 0.0 {
             if o < lo || o > hi {
                 return None;
@@ -78,29 +116,79 @@ pub fn ray_aabb(ray: &Ray, b: &Aabb) -> Option<(f32, f32)> {
         if ta > tb {
             std::mem::swap(&mut ta, &mut tb);
         }
-        // `max`/`min` ignore a NaN operand (∞ · 0 for an infinite box), which keeps
-        // the test conservative.
+        // `max`/`min` ignore a NaN operand (a NaN box), which keeps the test
+        // conservative.
         t0 = t0.max(ta);
         t1 = t1.min(tb);
         if t0 > t1 {
             return None;
         }
     }
-    Some((t0, t1))
+    Some((round_down(t0), round_up(t1)))
+}
+
+/// The largest `f32` not above `x`.
+#[inline]
+fn round_down(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) > x {
+        step_down(y)
+    } else {
+        y
+    }
+}
+
+/// The next `f32` toward −∞ (`f32::next_down` needs Rust 1.86; the MSRV is 1.80).
+#[inline]
+fn step_down(y: f32) -> f32 {
+    if y.is_nan() || y == f32::NEG_INFINITY {
+        y
+    } else if y == 0.0 {
+        -f32::from_bits(1)
+    } else if y > 0.0 {
+        f32::from_bits(y.to_bits() - 1)
+    } else {
+        f32::from_bits(y.to_bits() + 1)
+    }
+}
+
+/// The smallest `f32` not below `x`.
+#[inline]
+fn round_up(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) < x {
+        -step_down(-y)
+    } else {
+        y
+    }
+}
+
+#[inline]
+fn signed_distance(p: &crate::geom::Plane, c: [f64; 3]) -> f64 {
+    let n = d3(p.normal);
+    n[0] * c[0] + n[1] * c[1] + n[2] * c[2] + p.d as f64
 }
 
 /// Frustum–sphere, per plane: `Outside` if the sphere is entirely on the outer side of
-/// some plane (`distance < -r`), `Inside` if it is at least `r` inside every plane,
+/// some plane (`n·c + d < -r |n|`; `|n| = 1` for normalized planes), `Inside` if it is at least `r` inside every plane,
 /// else `Intersecting`. A sphere exactly touching a plane from outside is not culled.
+/// In `f64`; a NaN distance (only from a NaN plane) never culls.
 #[inline]
 pub fn frustum_sphere(f: &Frustum, s: &Sphere) -> Relation {
     let mut rel = Relation::Inside;
+    let c = d3(s.center);
     for p in &f.planes {
-        let d = p.signed_distance(s.center);
-        if d < -s.radius {
+        let d = signed_distance(p, c);
+        // The radius in the plane's units: `r |n|`. For the unit normals of
+        // `from_view_projection` this is `r`; for a zero normal (a degenerate
+        // matrix: the plane is everywhere inside or everywhere outside) it is 0,
+        // consistent with `frustum_aabb`, whose box extent also scales with |n|.
+        let n = d3(p.normal);
+        let r = s.radius as f64 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if d < -r {
             return Relation::Outside;
         }
-        if d < s.radius {
+        if d < r || d.is_nan() {
             rel = Relation::Intersecting;
         }
     }
@@ -113,22 +201,27 @@ pub fn frustum_sphere(f: &Frustum, s: &Sphere) -> Relation {
 /// contain the box entirely are dropped, so a child of this box needs to be tested
 /// only against the returned mask (plane masking). `Inside` when the returned mask
 /// is empty. A box that merely touches a plane from outside is not culled.
+///
+/// In `f64`, and conservative for boxes with infinite sides (loose bounds of huge
+/// objects): a NaN distance neither culls nor proves a plane contains the box.
 #[inline]
 pub fn frustum_aabb(f: &Frustum, b: &Aabb, mask: u8) -> (Relation, u8) {
-    let c = b.center();
-    let h = b.half_extent();
+    let (lo, hi) = (d3(b.min), d3(b.max));
+    let c = [0, 1, 2].map(|i| lo[i] * 0.5 + hi[i] * 0.5);
+    let h = [0, 1, 2].map(|i| hi[i] * 0.5 - lo[i] * 0.5);
     let mut out_mask = 0u8;
     for (i, p) in f.planes.iter().enumerate() {
         let bit = 1u8 << i;
         if mask & bit == 0 {
             continue;
         }
-        let s = p.signed_distance(c);
-        let e = p.normal.abs().dot(h);
+        let s = signed_distance(p, c);
+        let n = d3(p.normal.abs());
+        let e = n[0] * h[0] + n[1] * h[1] + n[2] * h[2];
         if s + e < 0.0 {
             return (Relation::Outside, 0);
         }
-        if s - e < 0.0 {
+        if s - e < 0.0 || (s - e).is_nan() {
             out_mask |= bit;
         }
     }
@@ -139,7 +232,8 @@ pub fn frustum_aabb(f: &Frustum, b: &Aabb, mask: u8) -> (Relation, u8) {
     }
 }
 
-/// Squared distance between two points (helper for callers that need it).
+/// Squared distance between two points (helper for callers that need it; in `f32`,
+/// so it overflows to infinity beyond about 1.8e19).
 #[inline]
 pub fn distance_squared(a: Vec3, b: Vec3) -> f32 {
     (a - b).length_squared()

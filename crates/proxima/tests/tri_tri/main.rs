@@ -4,6 +4,7 @@
 
 mod carath;
 mod cases;
+mod prop;
 mod random;
 mod reference;
 mod sym;

@@ -152,9 +152,16 @@ impl Geometry {
 
     /// Cells covered by the XY footprint (bounding square) of `s`.
     #[inline]
+    ///
+    /// Padded relative to `|centre| + radius` as well: far from the origin the
+    /// rounding of `c ± r` (and of the exact test's `f64` arithmetic) is relative to
+    /// the centre's magnitude, not to the bound's (a ball at y = -3e38 of radius
+    /// 3e38 has `c + r = 0` but the exact test may accept y = 11.5).
     pub fn sphere_rect(&self, s: &Sphere) -> CellRect {
-        let (x0, x1) = self.span(s.center.x - s.radius, s.center.x + s.radius, 0);
-        let (y0, y1) = self.span(s.center.y - s.radius, s.center.y + s.radius, 1);
+        let e = |c: f32| (c.abs() + s.radius) * REL_PAD;
+        let (cx, cy) = (s.center.x, s.center.y);
+        let (x0, x1) = self.span(cx - s.radius - e(cx), cx + s.radius + e(cx), 0);
+        let (y0, y1) = self.span(cy - s.radius - e(cy), cy + s.radius + e(cy), 1);
         CellRect { x0, y0, x1, y1 }
     }
 

@@ -153,8 +153,12 @@ impl Keys {
 
     /// Cells covered by the bounding box of `s`.
     #[inline]
+    ///
+    /// Padded relative to `|centre| + radius` too (see the 2D grid's `sphere_rect`).
     pub fn sphere_box(&self, s: &Sphere) -> KeyBox {
-        self.aabb_box(&s.aabb())
+        let e = (s.center.abs() + glam::Vec3::splat(s.radius)) * REL_PAD;
+        let r = glam::Vec3::splat(s.radius);
+        self.aabb_box(&Aabb::new(s.center - r - e, s.center + r + e))
     }
 
     /// A cell's loose box grown by the padding (see the 2D grid for why).

@@ -103,17 +103,25 @@ impl<T> HashGrid<T> {
             })
         };
         // Length of the walk, against the cost of scanning every occupied cell.
-        let walk = start.map(|(i, _)| {
-            let end = if ray.max_t.is_finite() {
-                k.coord(ray.at(ray.max_t)[a])
-            } else if forward {
-                LIMIT
+        // The last strip: the cell of the ray's end, padded in the direction of
+        // travel (far from the origin `o + d t` rounds by up to its magnitude times
+        // epsilon, and so do the strips' `t`s, which can then all round to `max_t`:
+        // the walk must stop at this cell, not wait for a `t` beyond `max_t`).
+        let end = if ray.max_t.is_finite() {
+            let v = ray.at(ray.max_t)[a];
+            let pad = (o[a].abs() + (d[a] * ray.max_t).abs()) * RAY_PAD;
+            if forward {
+                k.coord(v + pad)
             } else {
-                -LIMIT
-            };
-            let end = end.clamp(occ.lo[a], occ.hi[a]);
-            (end as i64 - i as i64).unsigned_abs() + 1
-        });
+                k.coord(v - pad)
+            }
+        } else if forward {
+            LIMIT
+        } else {
+            -LIMIT
+        };
+        let end = end.clamp(occ.lo[a], occ.hi[a]);
+        let walk = start.map(|(i, _)| (end as i64 - i as i64).unsigned_abs() + 1);
         let Some((mut i, mut ta)) = start.filter(|_| {
             walk.unwrap_or(u64::MAX).saturating_mul(LOOKUPS_PER_STRIP) <= self.map.len() as u64
         }) else {
@@ -174,34 +182,53 @@ impl<T> HashGrid<T> {
                 ranges[j] = (r0, r1);
             }
             let [(b0, b1), (c0, c1)] = ranges;
-            for rc in c0.max(occ.lo[c])..=c1.min(occ.hi[c]) {
-                for rb in b0.max(occ.lo[b])..=b1.min(occ.hi[b]) {
-                    let mut key = [0; 3];
-                    key[a] = i;
-                    key[b] = rb;
-                    key[c] = rc;
-                    let Some(&slot) = self.map.get(&key) else {
-                        continue;
-                    };
-                    let list = &self.cells[slot as usize].list;
-                    if !touches(key) {
+            let (rb0, rb1) = (b0.max(occ.lo[b]), b1.min(occ.hi[b]));
+            let (rc0, rc1) = (c0.max(occ.lo[c]), c1.min(occ.hi[c]));
+            let mut cell = |key: [i32; 3], slot: u32| -> ControlFlow<()> {
+                let list = &self.cells[slot as usize].list;
+                if !touches(key) {
+                    return ControlFlow::Continue(());
+                }
+                let (rb, rc) = (key[b], key[c]);
+                for e in &list.entries {
+                    let ob: KeyBox = k.sphere_box(&self.spheres[e.slot as usize]);
+                    if rb != b0.max(ob.lo[b]) || rc != c0.max(ob.lo[c]) {
                         continue;
                     }
-                    for e in &list.entries {
-                        let ob: KeyBox = k.sphere_box(&self.spheres[e.slot as usize]);
-                        if rb != b0.max(ob.lo[b]) || rc != c0.max(ob.lo[c]) {
-                            continue;
+                    if let Some((pi, p)) = prev {
+                        if ob.lo[a] <= pi
+                            && pi <= ob.hi[a]
+                            && meet(p[0].0, p[0].1, ob.lo[b], ob.hi[b])
+                            && meet(p[1].0, p[1].1, ob.lo[c], ob.hi[c])
+                        {
+                            continue; // met in the previous strip
                         }
-                        if let Some((pi, p)) = prev {
-                            if ob.lo[a] <= pi
-                                && pi <= ob.hi[a]
-                                && meet(p[0].0, p[0].1, ob.lo[b], ob.hi[b])
-                                && meet(p[1].0, p[1].1, ob.lo[c], ob.hi[c])
-                            {
-                                continue; // met in the previous strip
-                            }
+                    }
+                    step(Step::Candidate(e))?;
+                }
+                ControlFlow::Continue(())
+            };
+            // A strip wider than the number of occupied cells (huge padding far from
+            // the origin, or a widely spread scene) is served from the map instead
+            // of key by key, so one strip never costs more than one pass over it.
+            let area = (rb1 as i64 - rb0 as i64 + 1).max(0) * (rc1 as i64 - rc0 as i64 + 1).max(0);
+            if area as u64 > self.map.len() as u64 {
+                for (key, &slot) in &self.map {
+                    if key[a] == i && (rb0..=rb1).contains(&key[b]) && (rc0..=rc1).contains(&key[c])
+                    {
+                        cell(*key, slot)?;
+                    }
+                }
+            } else {
+                for rc in rc0..=rc1 {
+                    for rb in rb0..=rb1 {
+                        let mut key = [0; 3];
+                        key[a] = i;
+                        key[b] = rb;
+                        key[c] = rc;
+                        if let Some(&slot) = self.map.get(&key) {
+                            cell(key, slot)?;
                         }
-                        step(Step::Candidate(e))?;
                     }
                 }
             }
@@ -209,6 +236,9 @@ impl<T> HashGrid<T> {
             step(Step::StripDone { t_done: ta })?;
             let Some(next_line) = end_line else { break };
             if tb >= ray.max_t && line_t(next_line) > ray.max_t {
+                break;
+            }
+            if i == end {
                 break;
             }
             i = if forward { i + 1 } else { i - 1 };

@@ -176,10 +176,15 @@ impl<T> LooseKdTree<T> {
 /// `MAX_DEPTH_LIMIT + 2` entries suffice; the rest is margin.
 const STACK: usize = super::MAX_DEPTH_LIMIT as usize + 8;
 
-/// A traversal stack on the call stack: queries allocate nothing.
+/// A traversal stack on the call stack: queries allocate nothing. The depth bound
+/// above is an argument, not a check, so entries beyond [`STACK`] spill into a heap
+/// `Vec` instead of indexing out of bounds: a wrong bound costs an allocation,
+/// never a panic.
 pub(super) struct FixedStack<E: Copy + Default> {
     buf: [E; STACK],
     len: usize,
+    /// Entries pushed while `buf` was full (the most recent ones, so popped first).
+    spill: Vec<E>,
 }
 
 impl<E: Copy + Default> FixedStack<E> {
@@ -187,20 +192,44 @@ impl<E: Copy + Default> FixedStack<E> {
         FixedStack {
             buf: [E::default(); STACK],
             len: 0,
+            spill: Vec::new(),
         }
     }
     #[inline]
     pub fn push(&mut self, e: E) {
-        self.buf[self.len] = e;
-        self.len += 1;
+        if self.len < STACK {
+            self.buf[self.len] = e;
+            self.len += 1;
+        } else {
+            self.spill.push(e);
+        }
     }
     #[inline]
     pub fn pop(&mut self) -> Option<E> {
-        if self.len == 0 {
+        if let Some(e) = self.spill.pop() {
+            Some(e)
+        } else if self.len == 0 {
             None
         } else {
             self.len -= 1;
             Some(self.buf[self.len])
         }
+    }
+}
+
+#[cfg(test)]
+mod stack_tests {
+    use super::*;
+
+    #[test]
+    fn fixed_stack_spills_instead_of_overflowing() {
+        let mut s = FixedStack::<u32>::new();
+        for i in 0..(3 * STACK as u32) {
+            s.push(i);
+        }
+        for i in (0..(3 * STACK as u32)).rev() {
+            assert_eq!(s.pop(), Some(i));
+        }
+        assert_eq!(s.pop(), None);
     }
 }

@@ -15,8 +15,13 @@ use glam::{Affine3A, Vec3};
 /// Stored as `K` numbers: the `K/2` minima then the `K/2` maxima. Two k-DOPs overlap
 /// iff every slab interval overlaps: `K` float comparisons. A translation `t` shifts
 /// slab `i` by `dot(axis_i, t)`; a rotation needs a refit (see
-/// [`BoundingVolume::AXIS_ALIGNED`]). Other values of `K` do not compile into a
-/// usable type (construction panics at the first fit).
+/// [`BoundingVolume::AXIS_ALIGNED`]). Other values of `K` are rejected at compile
+/// time: every method evaluates a constant assertion on `K`, so using one with an
+/// unsupported `K` is a build error, never a panic:
+///
+/// ```compile_fail
+/// let _ = proxima::narrow::Kdop::<10>::empty();
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kdop<const K: usize> {
     /// `d[i]` is the minimum along axis `i`, `d[i + K/2]` the maximum.
@@ -91,9 +96,16 @@ fn fmax(a: f32, b: f32) -> f32 {
 impl<const K: usize> Kdop<K> {
     const H: usize = K / 2;
 
+    /// Evaluated (at compile time) by every method: `K` must be 14, 18 or 26.
+    const SUPPORTED: () = assert!(
+        K == 14 || K == 18 || K == 26,
+        "Kdop supports K = 14, 18 or 26"
+    );
+
     /// Index into [`AXES`] of slab `i` (`i < K/2`).
     #[inline(always)]
     const fn axis_index(i: usize) -> usize {
+        let () = Self::SUPPORTED;
         match K {
             14 | 26 => i,
             18 => {
@@ -116,6 +128,7 @@ impl<const K: usize> Kdop<K> {
     /// The empty k-DOP (every interval inverted), identity of [`BoundingVolume::merge`].
     #[inline]
     pub fn empty() -> Self {
+        let () = Self::SUPPORTED;
         let mut d = [f32::INFINITY; K];
         for v in d.iter_mut().skip(Self::H) {
             *v = f32::NEG_INFINITY;
@@ -126,6 +139,7 @@ impl<const K: usize> Kdop<K> {
     /// Grows the k-DOP to contain `p`. O(K).
     #[inline]
     pub fn add_point(&mut self, p: Vec3) {
+        let () = Self::SUPPORTED;
         let pr = project13(p);
         for i in 0..Self::H {
             let v = pr[Self::axis_index(i)];

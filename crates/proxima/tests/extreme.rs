@@ -1,0 +1,504 @@
+//! Extreme scenes, for every index: 100k objects at one point, coordinates near
+//! ±1e30, radii from 0 to 1e30, objects leaving the world and coming back, remove
+//! everything and re-insert (nothing leaks), ids reused; and the regression tests
+//! of the bugs found by fuzzing (named after them). Answers are compared with
+//! `BruteForce` or with hand-computed exact values.
+
+use proxima::broad::{
+    BruteForce, Handle, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex,
+    UniformGrid2d,
+};
+use proxima::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};
+use proxima::glam::{vec3, Mat4, Vec3};
+use proxima::Error;
+use std::collections::BTreeSet;
+use std::ops::ControlFlow;
+
+fn world() -> Aabb {
+    Aabb::new(Vec3::ZERO, Vec3::splat(100.0))
+}
+
+/// One test function per index, each calling `$body::<Index>(make)`.
+macro_rules! per_index {
+    ($body:ident) => {
+        mod $body {
+            use super::*;
+            #[test]
+            fn brute() {
+                super::$body(&|| BruteForce::new());
+            }
+            #[test]
+            fn loose_kd() {
+                super::$body(&|| LooseKdTree::new(world(), 2.0, 0.5).unwrap());
+            }
+            #[test]
+            fn octree() {
+                super::$body(&|| LinearOctree::new(world(), OctreeConfig::default()).unwrap());
+            }
+            #[test]
+            fn grid2d() {
+                super::$body(&|| UniformGrid2d::new(world(), 2.0).unwrap());
+            }
+            #[test]
+            fn hash_grid() {
+                super::$body(&|| HashGrid::new(2.0).unwrap());
+            }
+        }
+    };
+}
+
+fn ids<I: SpatialIndex<u32>>(i: &I, hs: Vec<Handle>) -> BTreeSet<u32> {
+    hs.into_iter().map(|h| *i.get(h).unwrap().1).collect()
+}
+
+fn pair_ids<I: SpatialIndex<u32>>(i: &I) -> BTreeSet<(u32, u32)> {
+    let mut out = BTreeSet::new();
+    let _ = i.for_each_pair(|_, &a, _, &b| {
+        out.insert((a.min(b), a.max(b)));
+        ControlFlow::Continue(())
+    });
+    out
+}
+
+/// Every query of `i` gives the same objects as brute force over `spheres`.
+fn agrees<I: SpatialIndex<u32>>(i: &I, spheres: &[(u32, Sphere)], queries: &[Sphere]) {
+    i.validate().unwrap();
+    let mut b = BruteForce::new();
+    for &(id, s) in spheres {
+        b.insert(s, id).unwrap();
+    }
+    for q in queries {
+        assert_eq!(
+            ids(i, i.sphere_hits(q).unwrap()),
+            ids(&b, b.sphere_hits(q).unwrap()),
+            "sphere {q:?}"
+        );
+        let bx = q.aabb();
+        if bx.validate().is_ok() {
+            assert_eq!(
+                ids(i, i.aabb_hits(&bx).unwrap()),
+                ids(&b, b.aabb_hits(&bx).unwrap()),
+                "aabb {bx:?}"
+            );
+        }
+    }
+    assert_eq!(pair_ids(i), pair_ids(&b), "pairs");
+}
+
+// ---- 100k objects at one point -------------------------------------------------
+
+const N_POINT: u32 = 100_000;
+
+fn hundred_k_at_one_point<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
+    let mut i = make();
+    let empty = i.memory_bytes();
+    let p = vec3(37.5, 37.5, 37.5);
+    let mut hs = Vec::new();
+    for k in 0..N_POINT {
+        // Zero radii and small ones, all centred on one point.
+        hs.push(i.insert(Sphere::new(p, (k % 3) as f32 * 0.5), k).unwrap());
+    }
+    assert_eq!(i.len(), N_POINT as usize);
+    i.validate().unwrap();
+    assert_eq!(i.within(p, 0.0).unwrap().len(), N_POINT as usize);
+    assert_eq!(
+        i.within(p + vec3(0.75, 0.0, 0.0), 0.0).unwrap().len(),
+        33_333
+    );
+    assert_eq!(i.within(p + Vec3::splat(10.0), 1.0).unwrap().len(), 0);
+    let b = Aabb::new(p + Vec3::splat(1.0), p + Vec3::splat(2.0));
+    assert!(i.aabb_hits(&b).unwrap().is_empty());
+    let r = Ray::new(p - vec3(10.0, 0.0, 0.0), Vec3::X);
+    assert_eq!(i.ray_hits(&r).unwrap().len(), N_POINT as usize);
+    assert_eq!(i.ray_first(&r).unwrap().unwrap().t, 9.0);
+    // Early stop is honoured.
+    let mut n = 0;
+    let _ = i.query_sphere(&Sphere::new(p, 1.0), |_, _, _| {
+        n += 1;
+        ControlFlow::Break(())
+    });
+    assert_eq!(n, 1);
+    // Remove everything: back to empty; then clear gives the empty memory.
+    for h in hs {
+        i.remove(h).unwrap();
+    }
+    assert!(i.is_empty());
+    i.validate().unwrap();
+    i.clear();
+    assert_eq!(i.memory_bytes(), empty, "memory after clear");
+}
+per_index!(hundred_k_at_one_point);
+
+// ---- coordinates near ±1e30, radii 0 … 1e30 -------------------------------------
+
+fn huge_coordinates_and_radii<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
+    let mut i = make();
+    let big = 1e30f32;
+    let spheres: Vec<(u32, Sphere)> = vec![
+        (0, Sphere::new(vec3(big, 0.0, 0.0), 0.0)),
+        (1, Sphere::new(vec3(-big, 0.0, 0.0), big)),
+        (2, Sphere::new(Vec3::ZERO, big)),
+        (3, Sphere::new(vec3(5.0, 5.0, 5.0), 0.0)),
+        (4, Sphere::new(Vec3::splat(-big), 1.0)),
+        (5, Sphere::new(vec3(big, big, -big), big)),
+        (6, Sphere::new(vec3(50.0, 50.0, 50.0), 1e-30)),
+        (7, Sphere::new(vec3(0.0, 2.0 * big, 0.0), big)),
+        (8, Sphere::new(vec3(3e38, -3e38, 0.0), 3e38)),
+    ];
+    for &(id, s) in &spheres {
+        i.insert(s, id).unwrap();
+    }
+    // Exact answers: (1e30 + 5, 5, 5) is outside the ball of radius 1e30 at −1e30
+    // by about 5 units, and 0 touches 2 and 5 exactly.
+    let pairs = pair_ids(&i);
+    assert!(pairs.contains(&(0, 2)), "touching at 1e30");
+    assert!(pairs.contains(&(1, 2)));
+    assert!(pairs.contains(&(2, 7)), "touching at (0, 1e30, 0)");
+    assert!(!pairs.contains(&(1, 3)), "outside by 5 at 1e30");
+    assert!(pairs.contains(&(2, 3)));
+    let queries = [
+        Sphere::new(vec3(big, 0.0, 0.0), 0.0),
+        Sphere::new(Vec3::ZERO, 0.0),
+        Sphere::new(vec3(-1.0, 0.0, 0.0), 0.5),
+        Sphere::new(Vec3::splat(-big), big),
+        Sphere::new(vec3(0.0, 11.5, 0.0), 0.0),
+        Sphere::new(Vec3::ZERO, 3e38),
+        Sphere::new(vec3(50.0, 50.0, 50.0), 0.0),
+    ];
+    agrees(&i, &spheres, &queries);
+    assert_eq!(
+        ids(&i, i.within(vec3(big, 0.0, 0.0), 0.0).unwrap()),
+        BTreeSet::from([0, 2]) // 5 is at distance √2·1e30 > 1e30
+    );
+}
+per_index!(huge_coordinates_and_radii);
+
+// ---- leaving the world and coming back; remove all and re-insert -----------------
+
+fn leave_world_and_return<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
+    let mut i = make();
+    let empty = i.memory_bytes();
+    let mut spheres: Vec<(u32, Sphere)> = Vec::new();
+    let mut hs = Vec::new();
+    for k in 0..200u32 {
+        let c = vec3(
+            (k % 10) as f32 * 10.0,
+            (k / 10 % 10) as f32 * 10.0,
+            (k / 100) as f32 * 50.0,
+        );
+        let s = Sphere::new(c, 1.0 + (k % 4) as f32);
+        hs.push(i.insert(s, k).unwrap());
+        spheres.push((k, s));
+    }
+    let queries = [
+        Sphere::new(vec3(50.0, 50.0, 50.0), 30.0),
+        Sphere::new(vec3(-1e6, 0.0, 0.0), 10.0),
+        Sphere::new(vec3(1e20, 1e20, 0.0), 1e19),
+        Sphere::new(Vec3::ZERO, 5.0),
+    ];
+    agrees(&i, &spheres, &queries);
+    // Out to far away (and huge), then back.
+    for (step, far) in [1e3f32, 1e7, 1e20, 1e30].into_iter().enumerate() {
+        for (k, h) in hs.iter().enumerate() {
+            if k % 3 == step % 3 {
+                let s = Sphere::new(
+                    spheres[k].1.center + Vec3::splat(far),
+                    spheres[k].1.radius * (1.0 + step as f32),
+                );
+                i.update(*h, s).unwrap();
+                spheres[k].1 = s;
+            }
+        }
+        agrees(&i, &spheres, &queries);
+    }
+    for (k, h) in hs.iter().enumerate() {
+        let s = Sphere::new(vec3(k as f32 * 0.5, 50.0, 50.0), 1.0);
+        i.update(*h, s).unwrap();
+        spheres[k].1 = s;
+    }
+    agrees(&i, &spheres, &queries);
+    // Remove everything, then re-insert: ids (slots) are reused, old handles stale.
+    for h in &hs {
+        i.remove(*h).unwrap();
+    }
+    i.validate().unwrap();
+    assert!(i.is_empty());
+    for h in &hs {
+        assert_eq!(i.get(*h).err(), Some(Error::StaleHandle));
+        assert_eq!(i.remove(*h).err(), Some(Error::StaleHandle));
+    }
+    let mut again = Vec::new();
+    for (k, s) in &spheres {
+        again.push(i.insert(*s, *k).unwrap());
+    }
+    let old: BTreeSet<u32> = hs.iter().map(|h| h.index()).collect();
+    let new: BTreeSet<u32> = again.iter().map(|h| h.index()).collect();
+    assert_eq!(old, new, "slots are reused after removal");
+    assert!(hs.iter().all(|h| !again.contains(h)), "new generations");
+    agrees(&i, &spheres, &queries);
+    i.clear();
+    assert_eq!(i.memory_bytes(), empty, "memory after clear");
+    assert!(i.get(again[0]).is_err());
+}
+per_index!(leave_world_and_return);
+
+// ---- bad input leaves the index unchanged ------------------------------------------
+
+fn bad_input_is_rejected_and_changes_nothing<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
+    let mut i = make();
+    let h = i.insert(Sphere::new(Vec3::splat(10.0), 1.0), 7).unwrap();
+    let bad = [
+        Sphere::new(vec3(f32::NAN, 0.0, 0.0), 1.0),
+        Sphere::new(vec3(0.0, f32::INFINITY, 0.0), 1.0),
+        Sphere::new(Vec3::ZERO, -1.0),
+        Sphere::new(Vec3::ZERO, f32::NAN),
+        Sphere::new(Vec3::ZERO, f32::INFINITY),
+    ];
+    for s in bad {
+        assert!(i.insert(s, 1).is_err());
+        assert!(i.update(h, s).is_err());
+        assert!(i.sphere_hits(&s).is_err());
+    }
+    assert!(i.aabb_hits(&Aabb::new(Vec3::ONE, Vec3::ZERO)).is_err());
+    assert!(i.aabb_hits(&Aabb::new(Vec3::NAN, Vec3::ZERO)).is_err());
+    assert_eq!(
+        i.ray_hits(&Ray::new(Vec3::ZERO, Vec3::ZERO)).err(),
+        Some(Error::ZeroDirection)
+    );
+    assert!(i.ray_hits(&Ray::new(Vec3::ZERO, Vec3::NAN)).is_err());
+    assert!(i
+        .ray_hits(&Ray::with_max_t(Vec3::ZERO, Vec3::X, -1.0))
+        .is_err());
+    assert!(i.segment_hits(&Segment::new(Vec3::ONE, Vec3::ONE)).is_err());
+    assert!(Frustum::from_view_projection(Mat4::NAN).is_err());
+    assert_eq!(i.len(), 1);
+    assert_eq!(i.get(h).unwrap(), (Sphere::new(Vec3::splat(10.0), 1.0), &7));
+    i.validate().unwrap();
+}
+per_index!(bad_input_is_rejected_and_changes_nothing);
+
+// ---- regression tests of fuzz findings ----------------------------------------------
+
+/// Fuzz (index_ops): a ball at x = -1e30 of radius 1e30 and a point 5 units
+/// beyond its surface: `(r1 + r2)²` and `|c1 - c2|²` rounded to the same `f32`
+/// infinity (and to the same `f64`), so the test said "touching". Now exact.
+#[test]
+fn sphere_sphere_exact_at_1e30() {
+    let big = 1e30f32;
+    let ball = Sphere::new(vec3(-big, 0.0, 0.0), big);
+    assert!(!overlap::sphere_sphere(
+        &ball,
+        &Sphere::new(vec3(5.0, 5.0, 5.0), 0.0)
+    ));
+    assert!(overlap::sphere_sphere(&ball, &Sphere::new(Vec3::ZERO, 0.0)));
+    assert!(overlap::sphere_sphere(
+        &ball,
+        &Sphere::new(vec3(big, 0.0, 0.0), big)
+    ));
+    let far = Sphere::new(vec3(3e38, 0.0, 0.0), 0.0);
+    assert!(!overlap::sphere_sphere(
+        &far,
+        &Sphere::new(vec3(-3e38, 0.0, 0.0), 3e38)
+    ));
+    assert!(!overlap::sphere_sphere(
+        &far,
+        &Sphere::new(vec3(-3e38, 0.0, 0.0), 3.4e38)
+    ));
+    assert!(overlap::sphere_sphere(&far, &Sphere::new(Vec3::ZERO, 3e38)));
+    assert!(overlap::sphere_sphere(
+        &far,
+        &Sphere::new(vec3(3e38, 0.0, 3e38), 3e38)
+    ));
+    assert!(overlap::sphere_aabb(
+        &ball,
+        &Aabb::new(Vec3::ZERO, Vec3::ONE)
+    ));
+    assert!(!overlap::sphere_aabb(
+        &ball,
+        &Aabb::new(Vec3::splat(1.0), Vec3::splat(2.0))
+    ));
+}
+
+/// Fuzz (index_ops): an object at y = 3.4e38 gave the octree a loose box with
+/// infinite sides, whose centre is NaN; `frustum_aabb` then answered `Inside`
+/// and the frustum query reported the object without testing it.
+#[test]
+fn octree_frustum_infinite_loose_box() {
+    let mut o = LinearOctree::new(
+        Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0)),
+        OctreeConfig::default(),
+    )
+    .unwrap();
+    let mut b = BruteForce::new();
+    for (k, s) in [
+        Sphere::new(vec3(-32.0, 3.4028235e38, -32.0), 0.0),
+        Sphere::new(vec3(-32.0, -32.0, -32.0), 1e30),
+        Sphere::new(Vec3::ZERO, 1.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        o.insert(s, k as u32).unwrap();
+        b.insert(s, k as u32).unwrap();
+    }
+    let m = Mat4::perspective_rh(1.0, 1.0, 0.1, 50.0)
+        * Mat4::look_at_rh(vec3(0.0, 0.0, 20.0), Vec3::ZERO, Vec3::Y);
+    let f = Frustum::from_view_projection(m).unwrap();
+    assert_eq!(
+        ids(&o, o.frustum_hits(&f).unwrap()),
+        ids(&b, b.frustum_hits(&f).unwrap())
+    );
+    assert!(!ids(&o, o.frustum_hits(&f).unwrap()).contains(&0));
+}
+
+/// Fuzz (index_ops, proptest): a segment query on a hash grid holding objects
+/// ~1e9 cells apart walked a strip of ~1e18 keys (padding grows with the ray's
+/// magnitude): it hung. Wide strips are now served from the map of occupied cells.
+#[test]
+fn hash_grid_ray_wide_strip_hang() {
+    let mut g = HashGrid::with_cell_size(1.0).unwrap();
+    let mut b = BruteForce::new();
+    let spheres = [
+        Sphere::new(Vec3::ZERO, 1.0),
+        Sphere::new(vec3(0.0, 1e9, 1e9), 1.0),
+        Sphere::new(vec3(0.0, -1e9, -1e9), 1.0),
+        Sphere::new(vec3(3.0, 0.5, 0.0), 1.0),
+    ];
+    for (k, s) in spheres.into_iter().enumerate() {
+        g.insert(s, k as u32).unwrap();
+        b.insert(s, k as u32).unwrap();
+    }
+    for r in [
+        Ray::new(vec3(-1e14, 0.0, 0.0), Vec3::X),
+        Ray::new(vec3(-1e8, 0.0, 0.0), Vec3::X),
+        Ray::with_max_t(vec3(-1e8, 0.0, 0.0), Vec3::X, 2e8),
+    ] {
+        let hits = |i: &dyn Fn(&Ray) -> Vec<proxima::broad::RayHit>| -> Vec<u32> {
+            i(&r).iter().map(|h| h.t.to_bits()).collect()
+        };
+        assert_eq!(
+            hits(&|r| g.ray_hits(r).unwrap()),
+            hits(&|r| b.ray_hits(r).unwrap())
+        );
+    }
+}
+
+/// Fuzz (index_ops): a ball at y = -3e38 of radius 3e38 ends (in `f32`) at
+/// `c + r = 0`; the grids' cell ranges were padded relative to that bound, not to
+/// the centre's magnitude, while the exact test's answer depends on the latter.
+/// The grids now agree with brute force around such balls.
+#[test]
+fn grid_far_ball_cell_padding() {
+    let world = Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0));
+    let spheres = [
+        (0, Sphere::new(vec3(-1.25, -3e38, 6.0), 3e38)),
+        (1, Sphere::new(vec3(-1.25, -3.0e38, 6.0), 3.0000002e38)),
+        (2, Sphere::new(vec3(4.760838e23, 31.5, 30.75), 1e15)),
+    ];
+    let queries: Vec<Sphere> = [0.0f32, 1e-3, 11.5, 1e20, 1e31, 3e38]
+        .iter()
+        .map(|&y| Sphere::new(vec3(-1.25, y, 6.0), 0.0))
+        .collect();
+    let mut g2 = UniformGrid2d::new(world, 2.0).unwrap();
+    let mut hg = HashGrid::new(2.0).unwrap();
+    for &(k, s) in &spheres {
+        g2.insert(s, k).unwrap();
+        hg.insert(s, k).unwrap();
+    }
+    agrees(&g2, &spheres, &queries);
+    agrees(&hg, &spheres, &queries);
+    let seg = Segment::new(vec3(2624.0, 11.5, 24.0), vec3(24.75, 13.5, -32.0));
+    let n = |hits: Vec<proxima::broad::RayHit>| hits.len();
+    let mut b = BruteForce::new();
+    for &(k, s) in &spheres {
+        b.insert(s, k).unwrap();
+    }
+    assert_eq!(
+        n(g2.segment_hits(&seg).unwrap()),
+        n(b.segment_hits(&seg).unwrap())
+    );
+    assert_eq!(
+        n(hg.segment_hits(&seg).unwrap()),
+        n(b.segment_hits(&seg).unwrap())
+    );
+}
+
+/// A box near `f32::MAX` has a finite centre (it was `(min + max) / 2 = inf`).
+#[test]
+fn aabb_center_does_not_overflow() {
+    let b = Aabb::new(Vec3::splat(2e38), Vec3::splat(3e38));
+    assert_eq!(b.center(), Vec3::splat(2.5e38));
+    assert!(b.half_extent().is_finite());
+    let o = LinearOctree::<u32>::new(b, OctreeConfig::default());
+    assert!(o.is_ok());
+}
+
+/// Fuzz (index_ops, timeout): a segment from x = 1e20 to x = -32 over a hash grid
+/// holding an object at x = -3e38. Every strip's `t` rounded to `max_t = 1`, so the
+/// walk's stop test never fired and it went on for ~1e9 strips. The walk now stops
+/// at the (padded) cell of the ray's end.
+#[test]
+fn hash_grid_far_segment_strip_loop() {
+    let mut g = HashGrid::with_cell_size(1.0).unwrap();
+    let mut b = BruteForce::new();
+    for (k, s) in [
+        Sphere::new(vec3(-3e38, -8192.0, -32.0), 16.5),
+        Sphere::new(vec3(-28.75, -30.0, -32.0), 15.375),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        g.insert(s, k as u32).unwrap();
+        b.insert(s, k as u32).unwrap();
+    }
+    let seg = Segment::new(vec3(1e20, -32.0, -32.0), vec3(-32.0, -32.0, -32.0));
+    let n = |h: Vec<proxima::broad::RayHit>| h.len();
+    assert_eq!(
+        n(g.segment_hits(&seg).unwrap()),
+        n(b.segment_hits(&seg).unwrap())
+    );
+    let r = Ray::with_max_t(vec3(1e20, -32.0, -32.0), vec3(-1e20, 0.0, 0.0), 1.0);
+    assert_eq!(n(g.ray_hits(&r).unwrap()), n(b.ray_hits(&r).unwrap()));
+}
+
+/// Fuzz (index_ops): a frustum with a zero-normal plane `0·p - 4.75 >= 0` (from a
+/// degenerate matrix: everywhere outside). The box test culled every node while
+/// the sphere test kept spheres of radius > 4.75 (it compared with `-r`, not with
+/// `-r |n|`). Both now scale the radius/extent by `|n|`.
+#[test]
+fn frustum_zero_normal_plane_consistent() {
+    use proxima::geom::Plane;
+    let mut planes = [Plane::new(Vec3::X, 1e3); 6];
+    planes[5] = Plane::new(Vec3::ZERO, -4.75);
+    let f = Frustum::from_planes(planes);
+    let big = Sphere::new(vec3(-32.0, -32.0, 27.0), 29.5);
+    assert_eq!(
+        overlap::frustum_sphere(&f, &big),
+        proxima::geom::Relation::Outside
+    );
+    let mut kd =
+        LooseKdTree::new(Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0)), 2.0, 0.5).unwrap();
+    let mut b = BruteForce::new();
+    for (k, s) in [Sphere::new(vec3(-8192.0, 0.0, -32.0), 0.0), big]
+        .into_iter()
+        .enumerate()
+    {
+        kd.insert(s, k as u32).unwrap();
+        b.insert(s, k as u32).unwrap();
+    }
+    assert!(b.frustum_hits(&f).unwrap().is_empty());
+    assert!(kd.frustum_hits(&f).unwrap().is_empty());
+    // A plane with a scaled normal is the same half-space.
+    planes[5] = Plane::new(vec3(0.0, 0.0, 2.0), 0.0);
+    let f = Frustum::from_planes(planes);
+    let touching = Sphere::new(vec3(0.0, 0.0, -1.0), 1.0);
+    assert_ne!(
+        overlap::frustum_sphere(&f, &touching),
+        proxima::geom::Relation::Outside
+    );
+    let out = Sphere::new(vec3(0.0, 0.0, -1.5), 1.0);
+    assert_eq!(
+        overlap::frustum_sphere(&f, &out),
+        proxima::geom::Relation::Outside
+    );
+}

@@ -1,0 +1,29 @@
+//! `proxima replay` on arbitrary bytes: the trace parser must return a trace or a
+//! one-line error, and every index must then replay the trace with the same answers
+//! as brute force. The CLI's modules are compiled in with `#[path]`.
+#![no_main]
+#![allow(dead_code)]
+
+#[path = "../../crates/proxima-cli/src/indices.rs"]
+mod indices;
+#[path = "../../crates/proxima-cli/src/replay.rs"]
+mod replay;
+#[path = "../../crates/proxima-cli/src/trace.rs"]
+mod trace;
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    let Ok(t) = trace::Trace::parse(data) else {
+        return;
+    };
+    let hint = t.scene_hint();
+    let mut runs = Vec::new();
+    for name in indices::NAMES {
+        match replay::run_one(name, &hint, &t) {
+            Ok(r) => runs.push(r),
+            Err(e) => panic!("{name} rejects a checked trace: {e}"),
+        }
+    }
+    if let Some((i, r, _)) = replay::disagreement(&runs) {
+        panic!("{} disagrees with brute force at query {i}", r.name);
+    }
+});

@@ -22,6 +22,22 @@ fn d3(v: Vec3) -> [f64; 3] {
 /// Exactly: `|p - q| <= r1 + r2` (radii non-negative).
 #[inline]
 pub(crate) fn within(p: Vec3, q: Vec3, r1: f32, r2: f32) -> bool {
+    // `f32` filter first: this test is the inner loop of every pair search. The
+    // computed squares carry a relative error below 6·2⁻²⁴ ≈ 4e-7 (one rounding per
+    // subtraction, square and sum), so a gap wider than 1e-5 of their size (plus
+    // an absolute term for underflow) decides with a 25× safety factor. An overflow
+    // to ∞ makes both comparisons false and falls through to `f64`.
+    let d = p - q;
+    let d2f = d.length_squared();
+    let rsf = r1 + r2;
+    let rs2f = rsf * rsf;
+    let marginf = 1e-5 * (d2f + rs2f) + 1e-35;
+    if d2f < rs2f - marginf {
+        return true;
+    }
+    if d2f > rs2f + marginf {
+        return false;
+    }
     let (a, b) = (d3(p), d3(q));
     let d2: f64 = (0..3).map(|i| (a[i] - b[i]) * (a[i] - b[i])).sum();
     let rs = r1 as f64 + r2 as f64;
@@ -243,6 +259,29 @@ pub fn distance_squared(a: Vec3, b: Vec3) -> f32 {
 mod tests {
     use super::*;
     use glam::{vec3, Mat4};
+
+    /// The `f32` filter of `within` never decides differently from the exact
+    /// predicate: on a coarse grid exact ties are common, and magnitudes up to
+    /// 1e30 overflow `f32` squares.
+    #[test]
+    fn f32_filter_agrees_with_exact_predicate() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
+        let mut ties = 0;
+        for k in 0..400_000 {
+            let scale = [1.0f32, 1.0 / 64.0, 1e-20, 1e15, 1e30][k % 5];
+            let mut g = || rng.gen_range(-8i32..=8) as f32 * scale;
+            let p = glam::vec3(g(), g(), g());
+            let q = glam::vec3(g(), g(), g());
+            let (r1, r2) = (g().abs(), g().abs());
+            let d = |v: glam::Vec3| [v.x as f64, v.y as f64, v.z as f64];
+            let exact = crate::geom::exact::within(d(p), d(q), r1 as f64, r2 as f64);
+            assert_eq!(within(p, q, r1, r2), exact, "{p} {q} {r1} {r2}");
+            let (dd, rs) = ((p - q).length_squared(), (r1 + r2) * (r1 + r2));
+            ties += (scale == 1.0 && dd == rs) as u32;
+        }
+        assert!(ties > 100, "the grid must produce exact ties ({ties})");
+    }
 
     #[test]
     fn touching_counts() {

@@ -122,26 +122,6 @@ impl<T> HashGrid<T> {
         };
         let end = end.clamp(occ.lo[a], occ.hi[a]);
         let walk = start.map(|(i, _)| (end as i64 - i as i64).unsigned_abs() + 1);
-        let Some((mut i, mut ta)) = start.filter(|_| {
-            walk.unwrap_or(u64::MAX).saturating_mul(LOOKUPS_PER_STRIP) <= self.map.len() as u64
-        }) else {
-            // Scan: each object from its own lowest cell.
-            for cell in &self.cells {
-                if cell.list.entries.is_empty() || !touches(cell.key) {
-                    continue;
-                }
-                for e in &cell.list.entries {
-                    if e.lo == cell.key {
-                        step(Step::Candidate(e))?;
-                    }
-                }
-            }
-            return ControlFlow::Continue(());
-        };
-        if ta > ray.max_t {
-            return ControlFlow::Continue(());
-        }
-
         // The ray's coordinate on `axis` at t, padded; f32::min/max skip the NaN
         // of ∞ − ∞ at an infinite end.
         let at = |axis: usize, t: f32| {
@@ -153,9 +133,9 @@ impl<T> HashGrid<T> {
             let pad = (o[axis].abs() + (d[axis] * t).abs()) * RAY_PAD;
             (v - pad, v + pad)
         };
-        // Raw (unclipped, monotone) ranges on b and c of the previous strip.
-        let mut prev: Option<(i32, [(i32, i32); 2])> = None;
-        loop {
+        // One strip: its end line, its parameter interval's end `tb` and its raw
+        // (unclipped, monotone) cell ranges on b and c.
+        let strip = |i: i32, ta: f32, prev: Option<(i32, [(i32, i32); 2])>| {
             let end_line = if forward {
                 (i < LIMIT).then_some(i + 1)
             } else {
@@ -181,6 +161,69 @@ impl<T> HashGrid<T> {
                 }
                 ranges[j] = (r0, r1);
             }
+            (end_line, tb, ranges)
+        };
+        let clipped_area = |ranges: [(i32, i32); 2]| {
+            let [(b0, b1), (c0, c1)] = ranges;
+            let (rb0, rb1) = (b0.max(occ.lo[b]), b1.min(occ.hi[b]));
+            let (rc0, rc1) = (c0.max(occ.lo[c]), c1.min(occ.hi[c]));
+            ((rb1 as i64 - rb0 as i64 + 1).max(0) * (rc1 as i64 - rc0 as i64 + 1).max(0)) as u64
+        };
+        let cells = self.map.len() as u64;
+        // Dry run of the walk (arithmetic only): its cost is at most one lookup per
+        // key of each strip, or one pass over the map for a strip wider than that.
+        // Far from the origin the padding can make every strip as wide as the
+        // occupied box; then scanning once is cheaper than walking (a fuzzed ray
+        // took 89 s walking).
+        let walk_cost_ok = |mut i: i32, mut ta: f32| {
+            let budget = LOOKUPS_PER_STRIP.saturating_mul(cells) + 64;
+            let mut cost = 0u64;
+            let mut prev = None;
+            loop {
+                let (end_line, tb, ranges) = strip(i, ta, prev);
+                cost = cost.saturating_add(clipped_area(ranges).min(cells));
+                if cost > budget {
+                    return false;
+                }
+                prev = Some((i, ranges));
+                let Some(next_line) = end_line else {
+                    return true;
+                };
+                if (tb >= ray.max_t && line_t(next_line) > ray.max_t) || i == end {
+                    return true;
+                }
+                i = if forward { i + 1 } else { i - 1 };
+                if i < occ.lo[a] || i > occ.hi[a] {
+                    return true;
+                }
+                ta = tb;
+            }
+        };
+        let Some((mut i, mut ta)) = start.filter(|&(i, ta)| {
+            walk.unwrap_or(u64::MAX).saturating_mul(LOOKUPS_PER_STRIP) <= cells
+                && (ta > ray.max_t || walk_cost_ok(i, ta))
+        }) else {
+            // Scan: each object from its own lowest cell.
+            for cell in &self.cells {
+                if cell.list.entries.is_empty() || !touches(cell.key) {
+                    continue;
+                }
+                for e in &cell.list.entries {
+                    if e.lo == cell.key {
+                        step(Step::Candidate(e))?;
+                    }
+                }
+            }
+            return ControlFlow::Continue(());
+        };
+        if ta > ray.max_t {
+            return ControlFlow::Continue(());
+        }
+
+        // Raw (unclipped, monotone) ranges on b and c of the previous strip.
+        let mut prev: Option<(i32, [(i32, i32); 2])> = None;
+        loop {
+            let (end_line, tb, ranges) = strip(i, ta, prev);
             let [(b0, b1), (c0, c1)] = ranges;
             let (rb0, rb1) = (b0.max(occ.lo[b]), b1.min(occ.hi[b]));
             let (rc0, rc1) = (c0.max(occ.lo[c]), c1.min(occ.hi[c]));
@@ -212,7 +255,10 @@ impl<T> HashGrid<T> {
             // the origin, or a widely spread scene) is served from the map instead
             // of key by key, so one strip never costs more than one pass over it.
             let area = (rb1 as i64 - rb0 as i64 + 1).max(0) * (rc1 as i64 - rc0 as i64 + 1).max(0);
-            if area as u64 > self.map.len() as u64 {
+            if area == 0 {
+                // An empty range on one axis: nothing to visit (the other axis's
+                // range may still be huge, so do not loop over it).
+            } else if area as u64 > self.map.len() as u64 {
                 for (key, &slot) in &self.map {
                     if key[a] == i && (rb0..=rb1).contains(&key[b]) && (rc0..=rc1).contains(&key[c])
                     {

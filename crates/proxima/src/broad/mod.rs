@@ -20,6 +20,8 @@ mod hash_grid;
 pub mod loose_kd;
 pub mod octree;
 mod selection;
+#[cfg(test)]
+mod test_util;
 
 pub use crate::arena::Handle;
 pub use brute::BruteForce;

@@ -203,7 +203,6 @@ mod tests {
     use crate::broad::{BruteForce, SpatialIndex, UniformGrid2d};
     use crate::geom::{Aabb, Ray, Segment, Sphere};
     use glam::{vec3, Vec3};
-    use std::ops::ControlFlow;
 
     fn sample() -> (UniformGrid2d<u32>, BruteForce<u32>) {
         let w = Aabb::new(Vec3::ZERO, vec3(100.0, 100.0, 10.0));
@@ -234,32 +233,8 @@ mod tests {
         (g, b)
     }
 
-    fn ids(v: Vec<crate::broad::RayHit>, i: &impl SpatialIndex<u32>) -> Vec<(u32, u32)> {
-        let mut v: Vec<_> = v
-            .iter()
-            .map(|h| (*i.get(h.handle).unwrap().1, h.t.to_bits()))
-            .collect();
-        v.sort_unstable();
-        v
-    }
-
     fn check(g: &UniformGrid2d<u32>, b: &BruteForce<u32>, r: &Ray) {
-        let mut seen = Vec::new();
-        let _ = g.query(r, |h, _, _| {
-            seen.push(h);
-            ControlFlow::Continue(())
-        });
-        let n = seen.len();
-        seen.sort();
-        seen.dedup();
-        assert_eq!(n, seen.len(), "reported twice: {r:?}");
-        assert_eq!(
-            ids(g.ray_hits(r).unwrap(), g),
-            ids(b.ray_hits(r).unwrap(), b),
-            "{r:?}"
-        );
-        let (fg, fb) = (g.ray_first(r).unwrap(), b.ray_first(r).unwrap());
-        assert_eq!(fg.map(|h| h.t), fb.map(|h| h.t), "{r:?}");
+        crate::broad::test_util::check_ray(g, b, r);
     }
 
     #[test]

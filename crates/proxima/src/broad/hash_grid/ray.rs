@@ -347,10 +347,9 @@ impl<T> HashGrid<T> {
 
 #[cfg(test)]
 mod tests {
-    use crate::broad::{BruteForce, HashGrid, RayHit, SpatialIndex};
+    use crate::broad::{BruteForce, HashGrid, SpatialIndex};
     use crate::geom::{Ray, Segment, Sphere};
     use glam::{vec3, Vec3};
-    use std::ops::ControlFlow;
 
     fn sample() -> (HashGrid<u32>, BruteForce<u32>) {
         let mut g = HashGrid::with_cell_size(3.0).unwrap();
@@ -377,32 +376,8 @@ mod tests {
         (g, b)
     }
 
-    fn ids(v: Vec<RayHit>, i: &impl SpatialIndex<u32>) -> Vec<(u32, u32)> {
-        let mut v: Vec<_> = v
-            .iter()
-            .map(|h| (*i.get(h.handle).unwrap().1, h.t.to_bits()))
-            .collect();
-        v.sort_unstable();
-        v
-    }
-
     fn check(g: &HashGrid<u32>, b: &BruteForce<u32>, r: &Ray) {
-        let mut seen = Vec::new();
-        let _ = g.query(r, |h, _, _| {
-            seen.push(h);
-            ControlFlow::Continue(())
-        });
-        let n = seen.len();
-        seen.sort();
-        seen.dedup();
-        assert_eq!(n, seen.len(), "reported twice: {r:?}");
-        assert_eq!(
-            ids(g.ray_hits(r).unwrap(), g),
-            ids(b.ray_hits(r).unwrap(), b),
-            "{r:?}"
-        );
-        let (fg, fb) = (g.ray_first(r).unwrap(), b.ray_first(r).unwrap());
-        assert_eq!(fg.map(|h| h.t), fb.map(|h| h.t), "{r:?}");
+        crate::broad::test_util::check_ray(g, b, r);
     }
 
     #[test]

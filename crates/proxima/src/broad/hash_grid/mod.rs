@@ -112,6 +112,25 @@ pub struct HashGrid<T> {
 }
 
 impl<T> HashGrid<T> {
+    /// An empty grid over `keys`: the one place that lists the fields, shared by the
+    /// constructors and `clear`.
+    fn empty(keys: Keys) -> Self {
+        HashGrid {
+            keys,
+            map: FxHashMap::default(),
+            cells: Vec::new(),
+            free_cells: Vec::new(),
+            items: Arena::new(),
+            spheres: Vec::new(),
+            handles: Vec::new(),
+            reach: Reach::default(),
+            oversized: Vec::new(),
+            refs: 0,
+            occupied: KeyBox::EMPTY,
+            stale: 0,
+        }
+    }
+
     /// A grid whose cells are twice `typical_radius` wide (a typical object then
     /// covers at most 2 × 2 × 2 cells). Errors unless the radius is finite and
     /// positive.
@@ -132,20 +151,7 @@ impl<T> HashGrid<T> {
                 "hash grid cell size {cell_size} must be finite and positive"
             )));
         }
-        Ok(HashGrid {
-            keys: Keys::new(cell_size),
-            map: FxHashMap::default(),
-            cells: Vec::new(),
-            free_cells: Vec::new(),
-            items: Arena::new(),
-            spheres: Vec::new(),
-            handles: Vec::new(),
-            reach: Reach::default(),
-            oversized: Vec::new(),
-            refs: 0,
-            occupied: KeyBox::EMPTY,
-            stale: 0,
-        })
+        Ok(HashGrid::empty(Keys::new(cell_size)))
     }
 
     /// Edge of a cell.
@@ -287,20 +293,7 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
 
     fn clear(&mut self) {
         let keys = self.keys;
-        *self = HashGrid {
-            keys,
-            map: FxHashMap::default(),
-            cells: Vec::new(),
-            free_cells: Vec::new(),
-            items: Arena::new(),
-            spheres: Vec::new(),
-            handles: Vec::new(),
-            reach: Reach::default(),
-            oversized: Vec::new(),
-            refs: 0,
-            occupied: KeyBox::EMPTY,
-            stale: 0,
-        };
+        *self = HashGrid::empty(keys);
     }
 
     fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {

@@ -106,3 +106,65 @@ impl<T: Send + Sync> SpatialIndex<T> for BruteForce<T> {
         std::mem::size_of::<Self>() + self.items.heap_bytes()
     }
 }
+
+/// Each object against every later one, the outer loop split over rayon's threads.
+/// Cost O(n²) divided by the thread count: the parallel oracle.
+#[cfg(feature = "parallel")]
+impl<T: Send + Sync> super::ParallelPairs<T> for BruteForce<T> {
+    fn par_fold_pairs<A, I, F, R>(&self, init: I, fold: F, reduce: R) -> A
+    where
+        A: Send,
+        I: Fn() -> A + Sync + Send,
+        F: Fn(A, Handle, &T, Handle, &T) -> A + Sync + Send,
+        R: Fn(A, A) -> A + Sync + Send,
+    {
+        use rayon::prelude::*;
+        let all: Vec<_> = self.items.iter().collect();
+        (0..all.len())
+            .into_par_iter()
+            .fold(&init, |mut acc, i| {
+                let (ha, (sa, va)) = all[i];
+                for (hb, (sb, vb)) in &all[i + 1..] {
+                    if overlap::sphere_sphere(sa, sb) {
+                        acc = fold(acc, ha, va, *hb, vb);
+                    }
+                }
+                acc
+            })
+            .reduce(&init, &reduce)
+    }
+}
+
+#[cfg(all(test, feature = "parallel"))]
+mod parallel_tests {
+    use super::*;
+    use crate::broad::ParallelPairs;
+    use glam::Vec3;
+
+    #[test]
+    fn parallel_pairs_equal_sequential_pairs() {
+        let mut b = BruteForce::new();
+        // A lattice of overlapping and touching spheres plus a removed one.
+        for i in 0..400u32 {
+            let p = Vec3::new((i % 20) as f32, (i / 20) as f32 * 0.9, (i % 7) as f32);
+            b.insert(Sphere::new(p, 0.5 + (i % 3) as f32 * 0.1), i)
+                .unwrap();
+        }
+        let h = b.insert(Sphere::new(Vec3::ZERO, 3.0), 999).unwrap();
+        b.remove(h).unwrap();
+        let mut seq = b.pairs();
+        seq.sort_unstable();
+        assert!(
+            seq.len() > 100,
+            "the scene must have pairs to compare: {}",
+            seq.len()
+        );
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let par = pool.install(|| b.par_pairs());
+        assert_eq!(par, seq);
+        assert_eq!(pool.install(|| b.par_count_pairs()), seq.len() as u64);
+    }
+}

@@ -19,6 +19,8 @@ mod grid2d;
 mod hash_grid;
 pub mod loose_kd;
 pub mod octree;
+#[cfg(feature = "parallel")]
+mod parallel;
 mod selection;
 #[cfg(test)]
 mod test_util;
@@ -29,6 +31,8 @@ pub use grid2d::UniformGrid2d;
 pub use hash_grid::HashGrid;
 pub use loose_kd::LooseKdTree;
 pub use octree::{LinearOctree, OctreeConfig};
+#[cfg(feature = "parallel")]
+pub use parallel::ParallelPairs;
 pub use selection::Selection;
 
 use crate::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};

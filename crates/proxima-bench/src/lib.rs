@@ -10,12 +10,14 @@
 //!   adapter over any `SpatialIndex<u32>`;
 //! - [`parry`]: the parry3d BVH adapter;
 //! - [`registry`]: the list of structures (one line per index);
-//! - [`run`]: timing and the pair-count ledger; [`report`]: tables and JSON.
+//! - [`run`]: timing and the pair-count ledger; [`report`]: tables and JSON;
+//! - [`chart`]: an SVG bar chart of any workload's `--json` output.
 //!
 //! Peers are dependencies of this crate only; the library stays light.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod chart;
 pub mod parry;
 pub mod registry;
 pub mod report;

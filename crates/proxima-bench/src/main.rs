@@ -1,4 +1,5 @@
 //! `proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only A,B] [--clock cpu|wall] [--json]`
+//! `proxima-bench chart FILE.json... --out FILE.svg [--metric NAME]`
 //!
 //! Runs one standard workload through every structure (Proxima's indices and the
 //! peers) and prints a table: build time, median update and pair-finding time per
@@ -14,7 +15,7 @@ use proxima_bench::workloads::Kind;
 use std::process::ExitCode;
 
 const USAGE: &str =
-    "usage: proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--json]";
+    "usage: proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--json]\n       proxima-bench chart FILE.json... --out FILE.svg [--metric NAME] [--title T]";
 
 struct Args {
     kind: Kind,
@@ -76,7 +77,17 @@ fn num<T: std::str::FromStr>(s: &str) -> Result<T, String> {
 }
 
 fn main() -> ExitCode {
-    let args = match parse(std::env::args().skip(1)) {
+    let argv: Vec<String> = std::env::args().skip(1).collect();
+    if argv.first().map(String::as_str) == Some("chart") {
+        return match proxima_bench::chart::main(&argv[1..]) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::from(2)
+            }
+        };
+    }
+    let args = match parse(argv.into_iter()) {
         Ok(a) => a,
         Err(e) => {
             if !e.is_empty() {

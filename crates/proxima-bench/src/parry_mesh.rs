@@ -87,4 +87,11 @@ impl ParryMeshes {
         }
         out
     }
+
+    /// parry's distance between triangle `i` of `a` at `pose` and triangle `j` of
+    /// `b` (0 when it considers them intersecting).
+    pub fn triangle_distance(&self, pose: &Pose, i: u32, j: u32) -> f32 {
+        let (ta, tb) = (self.a.triangle(i), self.b.triangle(j));
+        parry3d::query::distance(pose, &ta, &Pose::IDENTITY, &tb).map_or(f32::NAN, |d| d.distance)
+    }
 }

@@ -37,11 +37,17 @@ pub struct Disagreements {
     pub ours_only: usize,
     /// Disagreements where our exact test did NOT confirm our answer (must be 0).
     pub unverified: usize,
+    /// Largest distance (parry's own `query::distance`) between the triangles of
+    /// a pair only parry reports: how far its tolerance reaches.
+    pub parry_only_max_gap: f32,
+    /// Pairs only parry reports that its own distance query puts apart (> 0).
+    pub parry_only_apart: usize,
 }
 
 /// Compares parry's all pairs with ours (both sorted) on one pose, and checks each
 /// pair in the symmetric difference with the exact test on our moved corners:
 /// a pair only we report must intersect, a pair only parry reports must not.
+/// Returns the pairs only parry reports.
 pub fn compare_pairs(
     a: &TriMesh,
     pose: &Affine3A,
@@ -49,16 +55,19 @@ pub fn compare_pairs(
     ours: &[(u32, u32)],
     parry: &[(u32, u32)],
     d: &mut Disagreements,
-) {
+) -> Vec<(u32, u32)> {
     let exact = |&(i, j): &(u32, u32)| {
         triangles_intersect(&moved(a, pose, i as usize), &b.triangle(j as usize))
     };
+    let mut only = Vec::new();
     for p in parry.iter().filter(|p| ours.binary_search(p).is_err()) {
         d.parry_only += 1;
         d.unverified += exact(p) as usize;
+        only.push(*p);
     }
     for p in ours.iter().filter(|p| parry.binary_search(p).is_err()) {
         d.ours_only += 1;
         d.unverified += !exact(p) as usize;
     }
+    only
 }

@@ -12,15 +12,13 @@
 //! degenerate or nearly so), the exact [`triangles_intersect`] decides, so the
 //! answer is always the exact one.
 
+use super::predicates::O3D_ERRBOUND;
 use super::tri_tri::{guigue_devillers, one_strict_side, triangles_intersect};
 use glam::{DVec3, Vec3};
 
-/// Relative error bound of the `f64` evaluation of `det[b - a, c - a, d - a]` as
-/// a cofactor expansion of rounded differences, relative to its permanent (the
-/// same expansion with absolute values). Shewchuk's `o3derrboundA` is
-/// `(7 + 56ε)ε` with `ε = 2^-53` for the same operation structure (3 rounded
-/// differences per column, 2×2 minors, one dot product); `8ε` covers it.
-const ERRBOUND: f64 = 8.0 * (f64::EPSILON / 2.0);
+/// The error bound of [`orient3d`](super::predicates::orient3d)'s filter: `side`
+/// evaluates the same expansion with the triangle's part precomputed.
+const ERRBOUND: f64 = O3D_ERRBOUND;
 
 /// A triangle with its bounding box and plane precomputed for repeated
 /// [`PreparedTriangle::intersects`] tests.
@@ -97,7 +95,9 @@ impl PreparedTriangle {
     /// Certified signs of `other`'s corners against this triangle's plane.
     #[inline]
     fn sides(&self, other: &PreparedTriangle) -> [i8; 3] {
-        other.corners.map(|p| self.side(p))
+        // Spelled out: `array::map` here compiles to a slower generic loop.
+        let c = &other.corners;
+        [self.side(c[0]), self.side(c[1]), self.side(c[2])]
     }
 
     /// Whether the two closed triangles share a point: always the same answer as

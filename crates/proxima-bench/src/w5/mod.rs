@@ -3,7 +3,7 @@
 //! the peer.
 //!
 //! `proxima-bench w5 [--poses FILE] [--pairs rob-env,bunny,...] [--n N] [--seed S]
-//! [--brute K] [--clock cpu|wall] [--json]`
+//! [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall] [--json]`
 //!
 //! - `rob-env` (FCL's test: rob.obj moving, env.obj fixed) uses the pose file
 //!   (default `data/rob-env-1000.poses`, FCL's distribution); the other pairs use
@@ -28,12 +28,12 @@ use check::Disagreements;
 use ours::BvRun;
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::Affine3A;
-use proxima::narrow::{Kdop14, Kdop18, Kdop26, Obb, TriMesh};
+use proxima::narrow::{Kdop14, Kdop18, Kdop26, Obb, RotationUpdate, TriMesh};
 use std::fmt::Write as _;
 use std::process::ExitCode;
 use std::time::Duration;
 
-const USAGE: &str = "usage: proxima-bench w5 [--poses FILE] [--pairs rob-env,bunny,teapot,hand-forearm,skin-ribcage] [--n N] [--seed S] [--brute K] [--clock cpu|wall] [--json]";
+const USAGE: &str = "usage: proxima-bench w5 [--poses FILE] [--pairs rob-env,bunny,teapot,hand-forearm,skin-ribcage] [--n N] [--seed S] [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall] [--json]";
 
 /// The mesh pairs: name, moving mesh, fixed mesh (files in `shared/data/`).
 const PAIRS: [(&str, &str, &str); 5] = [
@@ -55,6 +55,7 @@ struct Args {
     n: usize,
     seed: u64,
     brute: usize,
+    rotation: RotationUpdate,
     clock: Clock,
     json: bool,
 }
@@ -66,6 +67,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         n: 200,
         seed: 5,
         brute: 20,
+        rotation: RotationUpdate::Auto,
         clock: Clock::ThreadCpu,
         json: false,
     };
@@ -95,6 +97,18 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--n" => a.n = num(value("--n")?)? as usize,
             "--seed" => a.seed = num(value("--seed")?)?,
             "--brute" => a.brute = num(value("--brute")?)? as usize,
+            "--rotation" => {
+                a.rotation = match value("--rotation")?.as_str() {
+                    "auto" => RotationUpdate::Auto,
+                    "refit" => RotationUpdate::Refit,
+                    "conservative" => RotationUpdate::Conservative,
+                    o => {
+                        return Err(format!(
+                            "--rotation takes auto, refit or conservative, not {o:?}"
+                        ))
+                    }
+                }
+            }
             "--clock" => {
                 a.clock = match value("--clock")?.as_str() {
                     "cpu" => Clock::ThreadCpu,
@@ -161,17 +175,17 @@ fn run_pair(
         .brute
         .min((BRUTE_BUDGET / (a.len() * b.len())).max(1))
         .min(poses.len());
-    let (c, k) = (args.clock, brute_poses);
+    let (c, k, r) = (args.clock, brute_poses, args.rotation);
     let mut bvs = Vec::new();
     for bv in ["aabb", "kdop14", "kdop18", "kdop26", "obb", "sphere"] {
         eprintln!("  {name}: {bv} ...");
         bvs.push(match bv {
-            "aabb" => ours::measure::<Aabb>(&a, &b, &poses, c, k)?,
-            "kdop14" => ours::measure::<Kdop14>(&a, &b, &poses, c, k)?,
-            "kdop18" => ours::measure::<Kdop18>(&a, &b, &poses, c, k)?,
-            "kdop26" => ours::measure::<Kdop26>(&a, &b, &poses, c, k)?,
-            "obb" => ours::measure::<Obb>(&a, &b, &poses, c, k)?,
-            _ => ours::measure::<Sphere>(&a, &b, &poses, c, k)?,
+            "aabb" => ours::measure::<Aabb>(&a, &b, &poses, c, k, r)?,
+            "kdop14" => ours::measure::<Kdop14>(&a, &b, &poses, c, k, r)?,
+            "kdop18" => ours::measure::<Kdop18>(&a, &b, &poses, c, k, r)?,
+            "kdop26" => ours::measure::<Kdop26>(&a, &b, &poses, c, k, r)?,
+            "obb" => ours::measure::<Obb>(&a, &b, &poses, c, k, r)?,
+            _ => ours::measure::<Sphere>(&a, &b, &poses, c, k, r)?,
         });
     }
     // Every volume: same count on every pose, first contact consistent.
@@ -283,9 +297,9 @@ fn run_parry(
     Ok(r)
 }
 
-fn table(runs: &[PairRun], clock: Clock) -> String {
+fn table(runs: &[PairRun], rotation: RotationUpdate, clock: Clock) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "w5 mesh vs mesh, SAH trees (leaf 1), clock={} (times per query; pair counts checked equal for every BV on every pose)", clock.name());
+    let _ = writeln!(s, "w5 mesh vs mesh, SAH trees (leaf 1), rotation={:?}, clock={} (times per query; pair counts checked equal for every BV on every pose)", rotation, clock.name());
     for p in runs {
         let pr = &p.parry;
         let (pa, pf) = (median(&pr.all), median(&pr.first));
@@ -384,7 +398,7 @@ pub fn main(args: impl Iterator<Item = String>) -> ExitCode {
         if args.json {
             json(&runs, args.clock)
         } else {
-            table(&runs, args.clock)
+            table(&runs, args.rotation, args.clock)
         }
     );
     for e in &errors {

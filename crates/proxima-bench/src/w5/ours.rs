@@ -37,6 +37,7 @@ pub fn measure<BV: BoundingVolume>(
     poses: &[Affine3A],
     clock: Clock,
     keep: usize,
+    rotation: RotationUpdate,
 ) -> Result<BvRun, String> {
     let opts = BuildOptions::default();
     let (trees, build) = clock.time(|| (Bvh::<BV>::build(a, opts), Bvh::<BV>::build(b, opts)));
@@ -44,7 +45,7 @@ pub fn measure<BV: BoundingVolume>(
         trees.0.map_err(|e| e.to_string())?,
         trees.1.map_err(|e| e.to_string())?,
     );
-    let mut col = Collider::<BV>::new(RotationUpdate::Auto);
+    let mut col = Collider::<BV>::new(rotation);
     let mut r = BvRun {
         name: BV::NAME,
         build,

@@ -19,11 +19,12 @@ const MAX_POSE_DEVIATION: f32 = 1e-3;
 /// (OBB, sphere) ignore this: their test takes the pose directly.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum RotationUpdate {
-    /// [`RotationUpdate::Conservative`] for first-contact queries and for moving
-    /// trees of more than 4,096 nodes (where a full refit costs more than the
-    /// traversal it saves), [`RotationUpdate::Refit`] otherwise. Chosen from the
-    /// W5 benchmark (rob vs env: the refit wins all-pairs slightly, the lazy update
-    /// wins first contact ~3×; SKINbody vs ribcage: the refit of 68k nodes dominates).
+    /// Currently [`RotationUpdate::Conservative`] for every query. Chosen from the
+    /// W5 benchmark (`proxima-bench w5 --rotation ...`): since triangle pairs are
+    /// tested through [`PreparedTriangle`](crate::narrow::PreparedTriangle), the
+    /// extra pair tests of the looser volumes cost less than refitting every node
+    /// (rob vs env, k-DOP18 all pairs: 34 µs mean conservative vs 40–43 µs refit;
+    /// teapot and hand-vs-forearm, ~2,000-node trees: 3.5 µs vs 47 µs median).
     #[default]
     Auto,
     /// The seed's method: transform the moving mesh's vertices and recompute every
@@ -262,10 +263,7 @@ impl<BV: BoundingVolume> Collider<BV> {
         let moved = |v: u32| pose.transform_point3(va[v as usize]);
         if BV::AXIS_ALIGNED && rotated {
             let update = match *rotation {
-                RotationUpdate::Auto if first || ta.nodes.len() > 4096 => {
-                    RotationUpdate::Conservative
-                }
-                RotationUpdate::Auto => RotationUpdate::Refit,
+                RotationUpdate::Auto => RotationUpdate::Conservative,
                 r => r,
             };
             match update {

@@ -299,7 +299,7 @@ fn run_parry(
 
 fn table(runs: &[PairRun], rotation: RotationUpdate, clock: Clock) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "w5 mesh vs mesh, SAH trees (leaf 1), rotation={:?}, clock={} (times per query; pair counts checked equal for every BV on every pose)", rotation, clock.name());
+    let _ = writeln!(s, "w5 mesh vs mesh, SAH trees (leaf 1), rotation={:?}, clock={} (times per query; vs parry = our median / parry median; pair counts checked equal for every BV on every pose)", rotation, clock.name());
     for p in runs {
         let pr = &p.parry;
         let (pa, pf) = (median(&pr.all), median(&pr.first));

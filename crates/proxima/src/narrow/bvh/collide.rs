@@ -3,9 +3,9 @@
 
 use super::traverse::{traverse, Lazy, Local, Precomputed};
 use super::tree::Bvh;
-use super::tri_cache::TriangleCache;
+use super::tri_cache::{QueryCache, TriangleCache};
 use crate::narrow::bv::{slack_for, BoundingVolume};
-use crate::narrow::TriMesh;
+use crate::narrow::{PreparedTriangle, TriMesh};
 use crate::{Error, Result};
 use glam::{Affine3A, Mat3A, Vec3};
 
@@ -74,7 +74,7 @@ pub struct Collider<BV> {
     pub rotation: RotationUpdate,
     world_vertices: Vec<Vec3>,
     world: Vec<BV>,
-    cache: Vec<Option<BV>>,
+    cache: QueryCache<BV>,
     stack: Vec<(u32, u32)>,
     /// Prepared triangles of the moving mesh (world frame) and of the fixed one.
     tris_a: TriangleCache,
@@ -144,7 +144,7 @@ impl<BV: BoundingVolume> Collider<BV> {
             rotation,
             world_vertices: Vec::new(),
             world: Vec::new(),
-            cache: Vec::new(),
+            cache: QueryCache::default(),
             stack: Vec::new(),
             tris_a: TriangleCache::default(),
             tris_b: TriangleCache::default(),
@@ -234,17 +234,19 @@ impl<BV: BoundingVolume> Collider<BV> {
             tris_a,
             tris_b,
         } = self;
-        tris_a.begin(ta.tris.len());
-        tris_b.begin(tb.tris.len());
+        tris_a.begin(ta.tris.len(), Default::default());
+        tris_b.begin(tb.tris.len(), Default::default());
         let rotated = pose.matrix3 != Mat3A::IDENTITY;
         let mut np = 0u64;
         // Leaf pair: every triangle pair, the first mesh's corners from `corner`.
         // Each triangle is prepared (corners moved, box, plane) once per query.
         let mut leaf = |corner: &dyn Fn(u32) -> Vec3, la: usize, lb: usize| -> bool {
             for k in ta.nodes[la].triangle_range() {
-                let pa = tris_a.get(k, || ta.tris[k].map(corner));
+                let pa = tris_a.get(k, || PreparedTriangle::new(ta.tris[k].map(corner)));
                 for m in tb.nodes[lb].triangle_range() {
-                    let pb = tris_b.get(m, || tb.tris[m].map(|v| vb[v as usize]));
+                    let pb = tris_b.get(m, || {
+                        PreparedTriangle::new(tb.tris[m].map(|v| vb[v as usize]))
+                    });
                     np += 1;
                     let hit = match custom {
                         None => pa.intersects(pb),
@@ -278,8 +280,7 @@ impl<BV: BoundingVolume> Collider<BV> {
                     });
                 }
                 _ => {
-                    cache.clear();
-                    cache.resize(ta.nodes.len(), None);
+                    cache.begin(ta.nodes.len(), ta.nodes[0].bv);
                     let mut src = Lazy {
                         nodes: &ta.nodes,
                         pose: *pose,

@@ -24,7 +24,7 @@ pub enum RotationUpdate {
     /// tested through [`PreparedTriangle`](crate::narrow::PreparedTriangle), the
     /// extra pair tests of the looser volumes cost less than refitting every node
     /// (rob vs env, k-DOP18 all pairs: 34 µs mean conservative vs 40–43 µs refit;
-    /// teapot and hand-vs-forearm, ~2,000-node trees: 3.5 µs vs 47 µs median).
+    /// teapot and hand-vs-forearm, ~2,000-node trees: ~1 µs vs 47 µs median).
     #[default]
     Auto,
     /// The seed's method: transform the moving mesh's vertices and recompute every

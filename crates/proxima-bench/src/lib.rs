@@ -10,6 +10,7 @@
 //!   adapter over any `SpatialIndex<u32>`;
 //! - [`parry`]: the parry3d BVH adapter;
 //! - [`registry`]: the list of structures (one line per index);
+//! - [`w5`]: the mesh-vs-mesh workload W5 and its peer [`parry_mesh`];
 //! - [`run`]: timing and the pair-count ledger; [`report`]: tables and JSON;
 //! - [`chart`]: an SVG bar chart of any workload's `--json` output.
 //!
@@ -19,8 +20,10 @@
 
 pub mod chart;
 pub mod parry;
+pub mod parry_mesh;
 pub mod registry;
 pub mod report;
 pub mod run;
 pub mod structure;
+pub mod w5;
 pub mod workloads;

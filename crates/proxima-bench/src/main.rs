@@ -78,14 +78,18 @@ fn num<T: std::str::FromStr>(s: &str) -> Result<T, String> {
 
 fn main() -> ExitCode {
     let argv: Vec<String> = std::env::args().skip(1).collect();
-    if argv.first().map(String::as_str) == Some("chart") {
-        return match proxima_bench::chart::main(&argv[1..]) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {e}");
-                ExitCode::from(2)
+    match argv.first().map(String::as_str) {
+        Some("chart") => {
+            return match proxima_bench::chart::main(&argv[1..]) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
+                }
             }
-        };
+        }
+        Some("w5") => return proxima_bench::w5::main(argv.into_iter().skip(1)),
+        _ => {}
     }
     let args = match parse(argv.into_iter()) {
         Ok(a) => a,

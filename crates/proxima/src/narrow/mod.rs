@@ -5,6 +5,7 @@ pub mod bv;
 mod bvh;
 mod coplanar;
 pub mod predicates;
+mod prepared;
 mod ray_triangle;
 mod segment;
 mod tri_tri;
@@ -15,6 +16,7 @@ pub use bvh::{
     check_pose, collide_all, collide_first, BuildOptions, Bvh, Collider, Contacts, CostCounters,
     FirstContact, Node, RayHit, RotationUpdate, SplitRule,
 };
+pub use prepared::PreparedTriangle;
 pub use ray_triangle::{ray_triangle, TriangleHit};
 pub use segment::{segment_triangle_intersect, segments_intersect};
 pub use tri_tri::triangles_intersect;

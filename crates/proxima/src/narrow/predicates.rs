@@ -49,11 +49,41 @@ fn sign(x: f64) -> i8 {
 /// `1` when `d` lies on the side of the plane `abc` that the normal
 /// `(b - a) × (c - a)` points to, `-1` on the other side, `0` when the four points
 /// are coplanar (or `a, b, c` are collinear). Swapping two arguments negates it.
+///
+/// Inlined filter first: the determinant of the rounded `f64` differences as a
+/// cofactor expansion, certified when it exceeds [`O3D_ERRBOUND`] times its
+/// permanent (Shewchuk's stage A); otherwise the `robust` crate's adaptive exact
+/// evaluation decides.
 #[inline]
 pub fn orient3d(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> i8 {
-    // `robust` returns det[a - d, b - d, c - d], the negation of ours.
-    -sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+    let o = a.as_dvec3();
+    let (u, v, w) = (b.as_dvec3() - o, c.as_dvec3() - o, d.as_dvec3() - o);
+    // Written out (no fused multiply-add): the bound is for this evaluation.
+    let (yz, zy) = (u.y * v.z, u.z * v.y);
+    let (zx, xz) = (u.z * v.x, u.x * v.z);
+    let (xy, yx) = (u.x * v.y, u.y * v.x);
+    let det = w.x * (yz - zy) + w.y * (zx - xz) + w.z * (xy - yx);
+    let permanent = w.x.abs() * (yz.abs() + zy.abs())
+        + w.y.abs() * (zx.abs() + xz.abs())
+        + w.z.abs() * (xy.abs() + yx.abs());
+    let bound = O3D_ERRBOUND * permanent;
+    if det > bound {
+        1
+    } else if det < -bound {
+        -1
+    } else {
+        // `robust` returns det[a - d, b - d, c - d], the negation of ours.
+        -sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+    }
 }
+
+/// Relative error bound of the `f64` evaluation of `det[u, v, w]` (each entry a
+/// rounded difference of `f32` coordinates) as `w · (u × v)`, relative to the
+/// permanent (the same expansion with absolute values). Shewchuk's
+/// `o3derrboundA = (7 + 56ε)ε`, `ε = 2^-53`, bounds this operation structure (three
+/// rounded differences per vector, 2×2 minors, one dot product); `8ε` covers it.
+/// No product can underflow or overflow for `f32` inputs (see the module docs).
+pub(crate) const O3D_ERRBOUND: f64 = 8.0 * (f64::EPSILON / 2.0);
 
 /// Exact sign of `det[b - a, c - a]`: `1` when `a, b, c` turn counter-clockwise,
 /// `-1` clockwise, `0` when collinear (or two points coincide).

@@ -68,7 +68,7 @@ fn proper_pair(a: &[Vec3; 3], b: &[Vec3; 3], ka: usize) -> bool {
     guigue_devillers(*a, sa, *b, sb)
 }
 
-fn one_strict_side(s: [i8; 3]) -> bool {
+pub(crate) fn one_strict_side(s: [i8; 3]) -> bool {
     s == [1; 3] || s == [-1; 3]
 }
 
@@ -84,7 +84,7 @@ fn one_strict_side(s: [i8; 3]) -> bool {
 /// same point: the two edge lines are transversal to the other plane and not
 /// parallel), and likewise for the second ends; the segments overlap iff both
 /// orderings allow it.
-fn guigue_devillers(a: [Vec3; 3], sa: [i8; 3], b: [Vec3; 3], sb: [i8; 3]) -> bool {
+pub(crate) fn guigue_devillers(a: [Vec3; 3], sa: [i8; 3], b: [Vec3; 3], sb: [i8; 3]) -> bool {
     let (mut a, flip_b) = isolate(a, sa);
     let mut b = b;
     let mut sb = sb;

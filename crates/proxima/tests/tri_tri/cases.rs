@@ -308,6 +308,7 @@ fn hand_made_cases_under_all_symmetries() {
                     "{name} (scale {scale}): {x:?} {y:?}"
                 );
                 assert_eq!(reference::intersect(&x, &y), want, "{name}: reference");
+                assert_eq!(super::prepared(&x, &y), want, "{name}: prepared");
             }
         }
     }

@@ -1,6 +1,8 @@
 //! Exactness tests of `proxima::narrow::triangles_intersect` against two
 //! references: `reference` (exact predicates, a different decomposition) and
-//! `carath` (integer arithmetic, Carathéodory; grid inputs only).
+//! `carath` (integer arithmetic, Carathéodory; grid inputs only). The same
+//! checks run `PreparedTriangle::intersects` (the filtered test the BVH queries
+//! use), which must give the exact answer too.
 
 mod carath;
 mod cases;
@@ -8,3 +10,12 @@ mod prop;
 mod random;
 mod reference;
 mod sym;
+
+/// The answer of the prepared (filtered) test, asserted equal in both orders.
+fn prepared(a: &[proxima::glam::Vec3; 3], b: &[proxima::glam::Vec3; 3]) -> bool {
+    use proxima::narrow::PreparedTriangle;
+    let (pa, pb) = (PreparedTriangle::new(*a), PreparedTriangle::new(*b));
+    let got = pa.intersects(&pb);
+    assert_eq!(pb.intersects(&pa), got, "prepared order: {a:?} {b:?}");
+    got
+}

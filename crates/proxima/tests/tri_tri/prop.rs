@@ -26,6 +26,8 @@ proptest! {
         let want = reference::intersect(&a, &b);
         prop_assert_eq!(triangles_intersect(&a, &b), want);
         prop_assert_eq!(triangles_intersect(&b, &a), want);
+        prop_assert_eq!(super::prepared(&a, &b), want);
+        prop_assert_eq!(super::prepared(&b, &a), want);
         let mut a2 = a;
         a2.rotate_left(rot);
         let mut b2 = b;

@@ -93,6 +93,7 @@ fn coplanar(r: &mut Pcg64) -> (Tri, Tri) {
 fn check(a: &Tri, b: &Tri, stats: &mut [usize; 2]) {
     let got = triangles_intersect(a, b);
     assert_eq!(got, reference::intersect(a, b), "{a:?} {b:?}");
+    assert_eq!(super::prepared(a, b), got, "prepared: {a:?} {b:?}");
     stats[got as usize] += 1;
 }
 
@@ -125,6 +126,7 @@ fn grid_pairs_against_integer_oracle() {
         let want = carath::intersect(&a, &b, 64.0).unwrap();
         assert_eq!(triangles_intersect(&a, &b), want, "{a:?} {b:?}");
         assert_eq!(reference::intersect(&a, &b), want, "reference: {a:?} {b:?}");
+        assert_eq!(super::prepared(&a, &b), want, "prepared: {a:?} {b:?}");
         stats[want as usize] += 1;
     }
     assert!(stats[0] > 20_000 && stats[1] > 20_000, "{stats:?}");
@@ -166,6 +168,31 @@ fn wide_exponent_range() {
             })
         };
         let (a, b) = (t(), t());
+        check(&a, &b, &mut stats);
+    }
+    assert!(stats[0] > 1000 && stats[1] > 1000, "{stats:?}");
+}
+
+#[test]
+fn extreme_exponent_spread() {
+    // Every f32 binade mixed inside one triangle, where differences are not exact
+    // even in f64: the prepared test's error bound must still certify only exact
+    // signs. Half the pairs share a corner, so touching answers are common.
+    let mut r = rng(4242);
+    let mut stats = [0usize; 2];
+    for i in 0..100_000 {
+        let mut p = || {
+            Vec3::from_array([(); 3].map(|_| {
+                let x: f32 = r.gen_range(-1.0..=1.0);
+                x * 2f32.powi(r.gen_range(-126..=126))
+            }))
+        };
+        let a = [p(), p(), p()];
+        let b = if i % 2 == 0 {
+            [a[0], p(), p()]
+        } else {
+            [p(), p(), p()]
+        };
         check(&a, &b, &mut stats);
     }
     assert!(stats[0] > 1000 && stats[1] > 1000, "{stats:?}");

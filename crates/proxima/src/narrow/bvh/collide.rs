@@ -3,10 +3,14 @@
 
 use super::traverse::{traverse, Lazy, Local, Precomputed};
 use super::tree::Bvh;
+use super::tri_cache::{QueryCache, TriangleCache};
 use crate::narrow::bv::{slack_for, BoundingVolume};
-use crate::narrow::TriMesh;
+use crate::narrow::{PreparedTriangle, TriMesh};
 use crate::{Error, Result};
 use glam::{Affine3A, Mat3A, Vec3};
+
+/// A caller's triangle predicate ([`Collider::all_pairs_with`]).
+type TriangleTest<'f> = dyn Fn(&[Vec3; 3], &[Vec3; 3]) -> bool + 'f;
 
 /// Largest accepted deviation of `RᵀR` from the identity (per entry).
 const MAX_POSE_DEVIATION: f32 = 1e-3;
@@ -15,11 +19,12 @@ const MAX_POSE_DEVIATION: f32 = 1e-3;
 /// (OBB, sphere) ignore this: their test takes the pose directly.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum RotationUpdate {
-    /// [`RotationUpdate::Conservative`] for first-contact queries and for moving
-    /// trees of more than 4,096 nodes (where a full refit costs more than the
-    /// traversal it saves), [`RotationUpdate::Refit`] otherwise. Chosen from the
-    /// W5 benchmark (rob vs env: the refit wins all-pairs slightly, the lazy update
-    /// wins first contact ~3×; SKINbody vs ribcage: the refit of 68k nodes dominates).
+    /// Currently [`RotationUpdate::Conservative`] for every query. Chosen from the
+    /// W5 benchmark (`proxima-bench w5 --rotation ...`): since triangle pairs are
+    /// tested through [`PreparedTriangle`](crate::narrow::PreparedTriangle), the
+    /// extra pair tests of the looser volumes cost less than refitting every node
+    /// (rob vs env, k-DOP18 all pairs: 34 µs mean conservative vs 40–43 µs refit;
+    /// teapot and hand-vs-forearm, ~2,000-node trees: ~1 µs vs 47 µs median).
     #[default]
     Auto,
     /// The seed's method: transform the moving mesh's vertices and recompute every
@@ -69,8 +74,11 @@ pub struct Collider<BV> {
     pub rotation: RotationUpdate,
     world_vertices: Vec<Vec3>,
     world: Vec<BV>,
-    cache: Vec<Option<BV>>,
+    cache: QueryCache<BV>,
     stack: Vec<(u32, u32)>,
+    /// Prepared triangles of the moving mesh (world frame) and of the fixed one.
+    tris_a: TriangleCache,
+    tris_b: TriangleCache,
 }
 
 impl<BV: BoundingVolume> Default for Collider<BV> {
@@ -136,15 +144,19 @@ impl<BV: BoundingVolume> Collider<BV> {
             rotation,
             world_vertices: Vec::new(),
             world: Vec::new(),
-            cache: Vec::new(),
+            cache: QueryCache::default(),
             stack: Vec::new(),
+            tris_a: TriangleCache::default(),
+            tris_b: TriangleCache::default(),
         }
     }
 
     /// Every pair `(i, j)` such that triangle `i` of mesh `a`, its vertices moved by
     /// `pose` (`pose.transform_point3`), intersects triangle `j` of mesh `b`
     /// according to [`triangles_intersect`](crate::narrow::triangles_intersect).
-    /// Each pair appears once.
+    /// Each pair appears once. The test runs as
+    /// [`PreparedTriangle::intersects`](crate::narrow::PreparedTriangle::intersects)
+    /// (same answers), each reached triangle prepared once per query.
     ///
     /// Cost: the traversal visits only pairs of overlapping volumes; with a rotated
     /// pose and axis-aligned volumes, the [`RotationUpdate`] adds `O(n_a)` (refit)
@@ -160,14 +172,7 @@ impl<BV: BoundingVolume> Collider<BV> {
         b: (&Bvh<BV>, &TriMesh),
     ) -> Result<Contacts> {
         let mut pairs = Vec::new();
-        let counters = self.run(
-            a,
-            pose,
-            b,
-            false,
-            &mut pairs,
-            crate::narrow::triangles_intersect,
-        )?;
+        let counters = self.run(a, pose, b, false, &mut pairs, None)?;
         Ok(Contacts { pairs, counters })
     }
 
@@ -184,7 +189,7 @@ impl<BV: BoundingVolume> Collider<BV> {
         triangle_test: impl Fn(&[Vec3; 3], &[Vec3; 3]) -> bool,
     ) -> Result<Contacts> {
         let mut pairs = Vec::new();
-        let counters = self.run(a, pose, b, false, &mut pairs, triangle_test)?;
+        let counters = self.run(a, pose, b, false, &mut pairs, Some(&triangle_test))?;
         Ok(Contacts { pairs, counters })
     }
 
@@ -196,14 +201,7 @@ impl<BV: BoundingVolume> Collider<BV> {
         b: (&Bvh<BV>, &TriMesh),
     ) -> Result<FirstContact> {
         let mut pairs = Vec::new();
-        let counters = self.run(
-            a,
-            pose,
-            b,
-            true,
-            &mut pairs,
-            crate::narrow::triangles_intersect,
-        )?;
+        let counters = self.run(a, pose, b, true, &mut pairs, None)?;
         Ok(FirstContact {
             pair: pairs.first().copied(),
             counters,
@@ -217,7 +215,7 @@ impl<BV: BoundingVolume> Collider<BV> {
         (tb, mb): (&Bvh<BV>, &TriMesh),
         first: bool,
         out: &mut Vec<(u32, u32)>,
-        tri_test: impl Fn(&[Vec3; 3], &[Vec3; 3]) -> bool,
+        custom: Option<&TriangleTest>,
     ) -> Result<CostCounters> {
         let dev = pose_deviation(pose)?;
         ta.check_vertices(ma.vertices().len())?;
@@ -233,19 +231,28 @@ impl<BV: BoundingVolume> Collider<BV> {
             world,
             cache,
             stack,
+            tris_a,
+            tris_b,
         } = self;
+        tris_a.begin(ta.tris.len(), Default::default());
+        tris_b.begin(tb.tris.len(), Default::default());
         let rotated = pose.matrix3 != Mat3A::IDENTITY;
         let mut np = 0u64;
         // Leaf pair: every triangle pair, the first mesh's corners from `corner`.
+        // Each triangle is prepared (corners moved, box, plane) once per query.
         let mut leaf = |corner: &dyn Fn(u32) -> Vec3, la: usize, lb: usize| -> bool {
             for k in ta.nodes[la].triangle_range() {
-                let t = ta.tris[k];
-                let tri_a = [corner(t[0]), corner(t[1]), corner(t[2])];
+                let pa = tris_a.get(k, || PreparedTriangle::new(ta.tris[k].map(corner)));
                 for m in tb.nodes[lb].triangle_range() {
-                    let u = tb.tris[m];
-                    let tri_b = [vb[u[0] as usize], vb[u[1] as usize], vb[u[2] as usize]];
+                    let pb = tris_b.get(m, || {
+                        PreparedTriangle::new(tb.tris[m].map(|v| vb[v as usize]))
+                    });
                     np += 1;
-                    if tri_test(&tri_a, &tri_b) {
+                    let hit = match custom {
+                        None => pa.intersects(pb),
+                        Some(test) => test(pa.corners(), pb.corners()),
+                    };
+                    if hit {
                         out.push((ta.ids[k], tb.ids[m]));
                         if first {
                             return true;
@@ -258,10 +265,7 @@ impl<BV: BoundingVolume> Collider<BV> {
         let moved = |v: u32| pose.transform_point3(va[v as usize]);
         if BV::AXIS_ALIGNED && rotated {
             let update = match *rotation {
-                RotationUpdate::Auto if first || ta.nodes.len() > 4096 => {
-                    RotationUpdate::Conservative
-                }
-                RotationUpdate::Auto => RotationUpdate::Refit,
+                RotationUpdate::Auto => RotationUpdate::Conservative,
                 r => r,
             };
             match update {
@@ -276,8 +280,7 @@ impl<BV: BoundingVolume> Collider<BV> {
                     });
                 }
                 _ => {
-                    cache.clear();
-                    cache.resize(ta.nodes.len(), None);
+                    cache.begin(ta.nodes.len(), ta.nodes[0].bv);
                     let mut src = Lazy {
                         nodes: &ta.nodes,
                         pose: *pose,

@@ -7,6 +7,7 @@
 //!   refit of a rotated tree (the seed's rotation update);
 //! - `traverse.rs`: the simultaneous descent of two trees (seed 003, Fig. 2);
 //! - `collide.rs`: mesh–mesh collision of two posed meshes with the cost counters;
+//! - `tri_cache.rs`: the per-query cache of prepared triangles;
 //! - `ray.rs`: ray and segment casts;
 //! - `validate.rs`: the structural invariants.
 
@@ -16,6 +17,7 @@ mod ray;
 mod refit;
 mod traverse;
 mod tree;
+mod tri_cache;
 mod validate;
 
 pub use build::{BuildOptions, SplitRule};

@@ -50,23 +50,19 @@ pub(crate) struct Lazy<'a, BV> {
     pub nodes: &'a [super::Node<BV>],
     pub pose: glam::Affine3A,
     pub slack: f32,
-    pub cache: &'a mut Vec<Option<BV>>,
+    pub cache: &'a mut super::tri_cache::QueryCache<BV>,
     pub updates: u64,
 }
 
 impl<BV: BoundingVolume> Lazy<'_, BV> {
     #[inline]
     fn get(&mut self, i: usize) -> &BV {
-        if self.cache[i].is_none() {
-            self.cache[i] = Some(
-                self.nodes[i]
-                    .bv
-                    .transformed(&self.pose)
-                    .inflated(self.slack),
-            );
+        if !self.cache.is_set(i) {
             self.updates += 1;
         }
-        self.cache[i].as_ref().expect("just filled")
+        let (nodes, pose, slack) = (self.nodes, &self.pose, self.slack);
+        self.cache
+            .get(i, || nodes[i].bv.transformed(pose).inflated(slack))
     }
 }
 

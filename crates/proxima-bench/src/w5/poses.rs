@@ -1,0 +1,68 @@
+//! W5 poses: FCL's rob-vs-env distribution from a pose file, and generated poses
+//! for the other mesh pairs.
+
+use proxima::glam::{Affine3A, Mat3, Quat, Vec3};
+use proxima::narrow::TriMesh;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+/// Parses a pose file (design §4.2): 12 numbers per line, a row-major rotation
+/// then a translation; `#` comments and blank lines skipped. Errors name the line.
+pub fn parse(name: &str, text: &str) -> Result<Vec<Affine3A>, String> {
+    let mut poses = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("");
+        if line.trim().is_empty() {
+            continue;
+        }
+        let n: Vec<f32> = line
+            .split_whitespace()
+            .map(|t| t.parse::<f32>().ok().filter(|v| v.is_finite()))
+            .collect::<Option<_>>()
+            .ok_or_else(|| format!("{name}:{}: not a finite number", i + 1))?;
+        if n.len() != 12 {
+            return Err(format!("{name}:{}: expected 12 numbers", i + 1));
+        }
+        let r = Mat3::from_cols_array(&[n[0], n[3], n[6], n[1], n[4], n[7], n[2], n[5], n[8]]);
+        let p = Affine3A::from_mat3_translation(r, Vec3::new(n[9], n[10], n[11]));
+        proxima::narrow::check_pose(&p).map_err(|e| format!("{name}:{}: {e}", i + 1))?;
+        poses.push(p);
+    }
+    Ok(poses)
+}
+
+fn bounds(m: &TriMesh) -> (Vec3, f32) {
+    let (lo, hi) = m.vertices().iter().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), &v| (lo.min(v), hi.max(v)),
+    );
+    ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+}
+
+/// `n` poses of `a` relative to `b`: rotations uniform over SO(3) (Shoemake),
+/// `a`'s centre uniform in a cube around `b`'s centre of half-side
+/// `0.6 * (r_a + r_b)` (bounding radii), so that a good share of the poses touch
+/// and the rest are near misses. Deterministic in `seed`.
+pub fn generate(a: &TriMesh, b: &TriMesh, n: usize, seed: u64) -> Vec<Affine3A> {
+    let ((ca, ra), (cb, rb)) = (bounds(a), bounds(b));
+    let h = 0.6 * (ra + rb);
+    let mut rng = Pcg64::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            let (u1, u2, u3): (f32, f32, f32) = (rng.gen(), rng.gen(), rng.gen());
+            let tau = std::f32::consts::TAU;
+            let (s1, s2) = ((1.0 - u1).sqrt(), u1.sqrt());
+            let q = Quat::from_xyzw(
+                s1 * (tau * u2).sin(),
+                s1 * (tau * u2).cos(),
+                s2 * (tau * u3).sin(),
+                s2 * (tau * u3).cos(),
+            )
+            .normalize();
+            let r = Mat3::from_quat(q);
+            let c = cb + Vec3::new(rng.gen(), rng.gen(), rng.gen()) * (2.0 * h) - Vec3::splat(h);
+            // Place a's centre at c after rotating it.
+            Affine3A::from_mat3_translation(r, c - r * ca)
+        })
+        .collect()
+}

@@ -31,7 +31,7 @@ pub(crate) fn within(p: Vec3, q: Vec3, r1: f32, r2: f32) -> bool {
     let d2f = d.length_squared();
     let rsf = r1 + r2;
     let rs2f = rsf * rsf;
-    let marginf = 1e-5 * (d2f + rs2f) + 1e-35;
+    let marginf = f32_margin(d2f, rs2f);
     if d2f < rs2f - marginf {
         return true;
     }
@@ -51,6 +51,41 @@ pub(crate) fn within(p: Vec3, q: Vec3, r1: f32, r2: f32) -> bool {
     } else {
         super::exact::within(a, b, r1 as f64, r2 as f64)
     }
+}
+
+/// Rounding margin of the `f32` filter of [`within`] for computed squares `d2f`
+/// (distance) and `rs2f` (radius sum).
+#[inline(always)]
+fn f32_margin(d2f: f32, rs2f: f32) -> f32 {
+    1e-5 * (d2f + rs2f) + 1e-35
+}
+
+/// Conservative pre-test for batched sphere–sphere loops, on plain coordinates
+/// (structure-of-arrays callers): `false` only if [`sphere_sphere`] is `false`
+/// for the spheres `(a, ar)` and `(b, br)`, so those need no exact test; `true`
+/// means "run [`sphere_sphere`]". It is the rejection step of `sphere_sphere`'s
+/// own `f32` filter (same operations, so the same rounding; a square is
+/// unchanged by the sign of the difference), branch-free so that loops over
+/// many spheres vectorize. O(1).
+#[allow(clippy::too_many_arguments, clippy::neg_cmp_op_on_partial_ord)]
+#[inline(always)]
+pub fn sphere_sphere_candidate(
+    ax: f32,
+    ay: f32,
+    az: f32,
+    ar: f32,
+    bx: f32,
+    by: f32,
+    bz: f32,
+    br: f32,
+) -> bool {
+    let (dx, dy, dz) = (ax - bx, ay - by, az - bz);
+    let d2f = dx * dx + dy * dy + dz * dz;
+    let rsf = ar + br;
+    let rs2f = rsf * rsf;
+    // Written as `!(>)` so that a NaN or an overflow to ∞ stays a candidate,
+    // exactly as `within` falls through to `f64` then.
+    !(d2f > rs2f + f32_margin(d2f, rs2f))
 }
 
 /// Sphere–sphere: `|c1 - c2| <= r1 + r2`, decided exactly (see the module).

@@ -7,11 +7,14 @@
 //! creation, placing and swap-removing objects),
 //! `update.rs` (removal and moves with climbing), `query.rs` (selection queries and
 //! the front-to-back ray search), `pairs.rs` (node-vs-node self collision),
+//! `pairs_par.rs` (the same walk split into rayon tasks, feature `parallel`),
 //! `validate.rs`, `stats.rs`, `visit.rs` (read-only node walk for pictures).
 
 mod insert;
 mod node;
 mod pairs;
+#[cfg(feature = "parallel")]
+mod pairs_par;
 mod query;
 mod stats;
 mod update;

@@ -90,7 +90,7 @@ struct Loc {
 ///
 /// # Costs
 ///
-/// Memory: one node per occupied cell (`size_of` ≈ 100 bytes) whose objects
+/// Memory: one node per occupied cell (`size_of` = 128 bytes, one cache-line-aligned block) whose objects
 /// (sphere, handle, payload) are stored contiguously in a vector owned by the node,
 /// plus one small arena slot per object giving its node and position. Nodes live in
 /// a pooled arena with a free list and the vectors of freed nodes are recycled, so

@@ -4,7 +4,7 @@
 //! Closed means boundaries count: touching shapes overlap. Costs are O(1).
 
 use crate::geom::{Aabb, Frustum, Ray, Relation, Sphere};
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 // The sphere tests are exact: whether `|p - q| <= r1 + r2` is decided for the
 // real numbers the `f32` inputs denote, at every magnitude. A fast `f64`
@@ -86,6 +86,24 @@ pub fn sphere_sphere_candidate(
     // Written as `!(>)` so that a NaN or an overflow to ∞ stays a candidate,
     // exactly as `within` falls through to `f64` then.
     !(d2f > rs2f + f32_margin(d2f, rs2f))
+}
+
+/// [`sphere_sphere_candidate`] for four spheres at once, given lane by lane
+/// (`x[j]`, `y[j]`, `z[j]`, `r[j]` for sphere `j`), against `s`: bit `j` of the
+/// result is set when sphere `j` is a candidate, i.e. clear only if
+/// [`sphere_sphere`] is `false` for it. The same operations as the scalar
+/// pre-test in each SIMD lane, so the same rounding. O(1).
+#[inline(always)]
+pub fn sphere_sphere_candidates4(x: Vec4, y: Vec4, z: Vec4, r: Vec4, s: &Sphere) -> u32 {
+    let dx = x - Vec4::splat(s.center.x);
+    let dy = y - Vec4::splat(s.center.y);
+    let dz = z - Vec4::splat(s.center.z);
+    let d2f = dx * dx + dy * dy + dz * dz;
+    let rsf = r + Vec4::splat(s.radius);
+    let rs2f = rsf * rsf;
+    let margin = Vec4::splat(1e-5) * (d2f + rs2f) + Vec4::splat(1e-35);
+    // `>` is false for NaN, so NaN and ∞ lanes stay candidates, as in the scalar test.
+    !d2f.cmpgt(rs2f + margin).bitmask() & 0xF
 }
 
 /// Sphere–sphere: `|c1 - c2| <= r1 + r2`, decided exactly (see the module).
@@ -292,6 +310,49 @@ pub fn distance_squared(a: Vec3, b: Vec3) -> f32 {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn candidates4_agree_with_the_scalar_pre_test_and_never_drop_an_overlap() {
+        // Near-tangent, overlapping, far, huge and tiny spheres.
+        let mut st = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            st ^= st << 13;
+            st ^= st >> 7;
+            st ^= st << 17;
+            (st >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for k in 0..20_000 {
+            let scale = [1e-3f32, 1.0, 1e3, 1e30][k % 4];
+            let s = Sphere::new(Vec3::new(next(), next(), next()) * scale, next() * scale);
+            let mut lanes = [Sphere::default(); 4];
+            for l in &mut lanes {
+                let dir = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize_or(Vec3::X);
+                let r = next() * scale;
+                // Around tangency: distance = (r + s.r) * (1 +- small).
+                let t = (r + s.radius) * (1.0 + (next() - 0.5) * 1e-5);
+                *l = Sphere::new(s.center + dir * t, r);
+            }
+            let v = |f: fn(&Sphere) -> f32| Vec4::from_array(lanes.map(|l| f(&l)));
+            let mask = sphere_sphere_candidates4(
+                v(|l| l.center.x),
+                v(|l| l.center.y),
+                v(|l| l.center.z),
+                v(|l| l.radius),
+                &s,
+            );
+            for (j, l) in lanes.iter().enumerate() {
+                let c = l.center;
+                let scalar = sphere_sphere_candidate(
+                    c.x, c.y, c.z, l.radius, s.center.x, s.center.y, s.center.z, s.radius,
+                );
+                assert_eq!(mask >> j & 1 == 1, scalar, "{l:?} vs {s:?}");
+                if sphere_sphere(l, &s) {
+                    assert!(scalar, "overlap rejected: {l:?} vs {s:?}");
+                }
+            }
+        }
+    }
+
     use super::*;
     use glam::{vec3, Mat4};
 

@@ -19,7 +19,7 @@
 //! The walks read each node's objects where they are stored, contiguously in the
 //! node (`Node::slots`); the carried sets are copies of the spheres, one array per
 //! coordinate (structure of arrays, see [`Carried`]), with the object's node and
-//! position, so the inner loop tests one sphere against eight carried ones with a
+//! position, so the inner loop tests one sphere against four carried ones with a
 //! branch-free `f32` pre-test that vectorizes (`overlap::sphere_sphere_candidate`)
 //! and runs the exact test only on the few candidates; only a reported pair goes
 //! back to the node for its handle and payload. A node's own objects are appended
@@ -34,7 +34,7 @@ use super::node::{FixedStack, Slot, NIL};
 use super::LooseKdTree;
 use crate::arena::Handle;
 use crate::geom::{overlap, Sphere};
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use std::ops::ControlFlow;
 use std::sync::{Mutex, TryLockError};
 
@@ -49,8 +49,8 @@ const SWEEP_MIN: usize = 128;
 /// without narrowing it first (see `worth_filtering`).
 const LEAF_FILTER_MIN: usize = 8;
 
-/// Spheres tested at once by the pre-test of [`Carried::scan`].
-const LANES: usize = 8;
+/// Spheres tested at once by the pre-test of [`Carried::scan`]: one SIMD `Vec4`.
+const LANES: usize = 4;
 
 /// A stack of carried objects in structure-of-arrays form: coordinates, radius
 /// and origin (node, position in the node) of entry `i` are `x[i]`, ..., `org[i]`.
@@ -167,8 +167,9 @@ impl Carried {
 
     /// [`Carried::refilter`] for one axis and direction (compiled separately, so
     /// the coordinate array is fixed). Branch-free: every entry is written at the
-    /// end, which advances only for kept ones. Reads stay below `to <= len`, writes
-    /// at or above `len`, so they never meet.
+    /// end, which advances only for kept ones (most are kept, and a branch per
+    /// entry measured slower). Reads stay below `to <= len`, writes at or above
+    /// `len`, so they never meet.
     fn refilter_on<const A: usize, const UPPER: bool>(
         &mut self,
         from: usize,
@@ -224,8 +225,9 @@ impl Carried {
     }
 
     /// Calls `hit(i)` for every entry `i` in `from..to` whose sphere overlaps `s`
-    /// (closed, exact). Eight entries at a time go through the branch-free `f32`
-    /// pre-test; only its candidates take the exact test, which decides.
+    /// (closed, exact). Four entries at a time go through the SIMD `f32` pre-test
+    /// (`overlap::sphere_sphere_candidates4`); only its candidates take the exact
+    /// test, which decides.
     #[inline]
     fn scan(
         &self,
@@ -237,15 +239,14 @@ impl Carried {
         let (sx, sy, sz, sr) = (s.center.x, s.center.y, s.center.z, s.radius);
         let mut i = from;
         while i + LANES <= to {
-            let x: &[f32; LANES] = self.x[i..i + LANES].try_into().expect("LANES long");
-            let y: &[f32; LANES] = self.y[i..i + LANES].try_into().expect("LANES long");
-            let z: &[f32; LANES] = self.z[i..i + LANES].try_into().expect("LANES long");
-            let r: &[f32; LANES] = self.r[i..i + LANES].try_into().expect("LANES long");
-            let mut mask = 0u32;
-            for j in 0..LANES {
-                let c = overlap::sphere_sphere_candidate(x[j], y[j], z[j], r[j], sx, sy, sz, sr);
-                mask |= (c as u32) << j;
-            }
+            let lanes = |v: &[f32]| Vec4::from_slice(&v[i..i + LANES]);
+            let mut mask = overlap::sphere_sphere_candidates4(
+                lanes(&self.x),
+                lanes(&self.y),
+                lanes(&self.z),
+                lanes(&self.r),
+                s,
+            );
             while mask != 0 {
                 let k = i + mask.trailing_zeros() as usize;
                 mask &= mask - 1;

@@ -1,4 +1,5 @@
-//! `proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only A,B] [--clock cpu|wall] [--json]`
+//! `proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only A,B] [--clock cpu|wall] [--threads K] [--json]`
+//! `proxima-bench w5 …` (see `proxima_bench::w5`)
 //! `proxima-bench chart FILE.json... --out FILE.svg [--metric NAME]`
 //!
 //! Runs one standard workload through every structure (Proxima's indices and the
@@ -6,16 +7,18 @@
 //! frame, pairs per frame (checked equal for every structure on every frame),
 //! bytes per object and frame time relative to parry3d. O(n²) structures are
 //! skipped above 20k objects. Times are the running thread's CPU time by default
-//! (`--clock wall` for elapsed time): this machine is shared.
+//! (`--clock wall` for elapsed time): this machine is shared. `--threads K`
+//! (default 1) counts pairs with the parallel search of the structures that
+//! have one, in a K-thread pool; with K > 1 the clock is wall time.
 
 use proxima_bench::registry::{self, QUADRATIC_LIMIT};
 use proxima_bench::report;
-use proxima_bench::run::{measure_all, Clock};
+use proxima_bench::run::{measure_all_threads, Clock};
 use proxima_bench::workloads::Kind;
 use std::process::ExitCode;
 
 const USAGE: &str =
-    "usage: proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--json]\n       proxima-bench chart FILE.json... --out FILE.svg [--metric NAME] [--title T]";
+    "usage: proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--threads K] [--json]\n       proxima-bench w5 [--help]\n       proxima-bench chart FILE.json... --out FILE.svg [--metric NAME] [--title T]";
 
 struct Args {
     kind: Kind,
@@ -24,6 +27,7 @@ struct Args {
     seed: u64,
     only: Vec<String>,
     clock: Clock,
+    threads: usize,
     json: bool,
 }
 
@@ -37,6 +41,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         seed: 1,
         only: Vec::new(),
         clock: Clock::ThreadCpu,
+        threads: 1,
         json: false,
     };
     while let Some(flag) = it.next() {
@@ -59,6 +64,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                     other => return Err(format!("--clock takes cpu or wall, not {other:?}")),
                 }
             }
+            "--threads" => a.threads = num(&value("--threads")?)?,
             "--json" => a.json = true,
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument {other:?}")),
@@ -66,6 +72,13 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     }
     if a.frames == 0 {
         return Err("--frames must be at least 1".into());
+    }
+    if a.threads == 0 {
+        return Err("--threads must be at least 1".into());
+    }
+    if a.threads > 1 {
+        // The caller's thread CPU time would miss the pool's work.
+        a.clock = Clock::Wall;
     }
     Ok(a)
 }
@@ -113,13 +126,14 @@ fn main() -> ExitCode {
         .filter(|e| !e.runs_on(args.n))
         .map(|e| e.name)
         .collect();
-    let results = measure_all(
+    let results = measure_all_threads(
         &entries,
         args.kind,
         args.n,
         args.seed,
         args.frames,
         args.clock,
+        args.threads,
         |e| eprintln!("running {} ...", e.name),
     );
     if args.json {
@@ -135,12 +149,13 @@ fn main() -> ExitCode {
         );
     } else {
         println!(
-            "{} n={} frames={} seed={} clock={} (medians per frame; pair counts checked equal on every frame)",
+            "{} n={} frames={} seed={} clock={} threads={} (medians per frame; pair counts checked equal on every frame)",
             args.kind.name(),
             args.n,
             args.frames,
             args.seed,
-            args.clock.name()
+            args.clock.name(),
+            args.threads
         );
         print!("{}", report::table(&results));
         if !skipped.is_empty() {

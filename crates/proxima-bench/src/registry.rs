@@ -2,7 +2,7 @@
 //! `proxima!` line in [`entries`].
 
 use crate::parry::ParryBvh;
-use crate::structure::{Indexed, Structure};
+use crate::structure::{Indexed, IndexedPar, Structure};
 use crate::workloads::Scene;
 use proxima::broad::{
     loose_kd, BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, UniformGrid2d,
@@ -44,6 +44,19 @@ macro_rules! proxima {
     ($name:expr, quadratic, $make:expr) => {
         proxima!(@entry $name, true, $make)
     };
+    // An index implementing `ParallelPairs` (used by `--threads K`).
+    ($name:expr, parallel, $make:expr) => {
+        Entry {
+            name: $name,
+            quadratic: false,
+            peer: false,
+            make: |scene: &Scene| -> Box<dyn Structure> {
+                let make: fn(&Scene) -> proxima::Result<_> = $make;
+                let index = make(scene).unwrap_or_else(|e| panic!("{}: {e}", $name));
+                Box::new(IndexedPar(Indexed::<_>::new(index)))
+            },
+        }
+    };
     (@entry $name:expr, $quadratic:expr, $make:expr) => {
         Entry {
             name: $name,
@@ -62,7 +75,7 @@ macro_rules! proxima {
 pub fn entries() -> Vec<Entry> {
     vec![
         proxima!("BruteForce", quadratic, |_| Ok(BruteForce::new())),
-        proxima!("LooseKdTree", |s| LooseKdTree::new(
+        proxima!("LooseKdTree", parallel, |s| LooseKdTree::new(
             s.world,
             s.r_max,
             loose_kd::DEFAULT_DENSITY

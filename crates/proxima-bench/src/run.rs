@@ -162,6 +162,30 @@ pub fn measure(
     clock: Clock,
     ledger: &mut PairLedger,
 ) -> Measurement {
+    measure_threads(entry, kind, n, seed, frames, clock, 1, ledger)
+}
+
+/// [`measure`] with `threads` threads for the pairs: with `threads > 1`, pairs
+/// are counted by [`Structure::count_pairs_par`] in a pool of that many threads
+/// (time it with [`Clock::Wall`]: the work runs on the pool's threads, not the
+/// caller's).
+#[allow(clippy::too_many_arguments)]
+pub fn measure_threads(
+    entry: &Entry,
+    kind: Kind,
+    n: usize,
+    seed: u64,
+    frames: usize,
+    clock: Clock,
+    threads: usize,
+    ledger: &mut PairLedger,
+) -> Measurement {
+    let pool = (threads > 1).then(|| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("building the benchmark's thread pool")
+    });
     let mut w = Workload::new(kind, n, seed);
     let mut s: Box<dyn Structure> = (entry.make)(&w.scene());
     let ((), build) = clock.time(|| s.build(&w.spheres));
@@ -179,7 +203,10 @@ pub fn measure(
         w.step();
         let ((), t) = clock.time(|| s.update(&w.spheres));
         m.update.push(t);
-        let (count, t) = clock.time(|| s.count_pairs());
+        let (count, t) = clock.time(|| match &pool {
+            Some(pool) => s.count_pairs_par(pool),
+            None => s.count_pairs(),
+        });
         m.pairs.push(t);
         ledger.check(w.frame(), entry.name, count);
         m.pair_total += count;
@@ -197,6 +224,21 @@ pub fn measure_all(
     seed: u64,
     frames: usize,
     clock: Clock,
+    progress: impl FnMut(&Entry),
+) -> Vec<Measurement> {
+    measure_all_threads(entries, kind, n, seed, frames, clock, 1, progress)
+}
+
+/// [`measure_all`] with `threads` threads for the pairs (see [`measure_threads`]).
+#[allow(clippy::too_many_arguments)]
+pub fn measure_all_threads(
+    entries: &[Entry],
+    kind: Kind,
+    n: usize,
+    seed: u64,
+    frames: usize,
+    clock: Clock,
+    threads: usize,
     mut progress: impl FnMut(&Entry),
 ) -> Vec<Measurement> {
     let mut ledger = PairLedger::new();
@@ -205,7 +247,7 @@ pub fn measure_all(
         .filter(|e| e.runs_on(n))
         .map(|e| {
             progress(e);
-            measure(e, kind, n, seed, frames, clock, &mut ledger)
+            measure_threads(e, kind, n, seed, frames, clock, threads, &mut ledger)
         })
         .collect()
 }

@@ -1,7 +1,7 @@
 //! One object-safe interface over everything the benchmarks run: Proxima's indices
 //! (through [`Indexed`], generic over [`SpatialIndex<u32>`]) and the peers.
 
-use proxima::broad::{Handle, SpatialIndex};
+use proxima::broad::{Handle, ParallelPairs, SpatialIndex};
 use proxima::geom::Sphere;
 use std::ops::ControlFlow;
 
@@ -18,6 +18,14 @@ pub trait Structure {
     /// Number of unordered pairs of objects whose spheres overlap (closed), each
     /// pair counted once.
     fn count_pairs(&mut self) -> u64;
+
+    /// As [`Structure::count_pairs`], split over the threads of `pool` by the
+    /// structures that implement [`ParallelPairs`] (`--threads K`). The default
+    /// counts sequentially on the calling thread.
+    fn count_pairs_par(&mut self, pool: &rayon::ThreadPool) -> u64 {
+        let _ = pool;
+        self.count_pairs()
+    }
 
     /// Bytes the structure holds, its copy of the spheres included.
     fn memory_bytes(&self) -> usize;
@@ -77,5 +85,32 @@ impl<I: SpatialIndex<u32>> Structure for Indexed<I> {
     fn memory_bytes(&self) -> usize {
         // The handle list is the benchmark's, not the index's: not counted.
         self.index.memory_bytes()
+    }
+}
+
+/// [`Indexed`] for an index with parallel pair finding: `count_pairs_par` runs
+/// `par_count_pairs` inside the given pool.
+pub struct IndexedPar<I>(pub Indexed<I>);
+
+impl<I: ParallelPairs<u32>> Structure for IndexedPar<I> {
+    fn build(&mut self, spheres: &[Sphere]) {
+        self.0.build(spheres)
+    }
+
+    fn update(&mut self, spheres: &[Sphere]) {
+        self.0.update(spheres)
+    }
+
+    fn count_pairs(&mut self) -> u64 {
+        self.0.count_pairs()
+    }
+
+    fn count_pairs_par(&mut self, pool: &rayon::ThreadPool) -> u64 {
+        let index = &self.0.index;
+        pool.install(|| index.par_count_pairs())
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.0.memory_bytes()
     }
 }

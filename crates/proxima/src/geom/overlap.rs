@@ -4,7 +4,7 @@
 //! Closed means boundaries count: touching shapes overlap. Costs are O(1).
 
 use crate::geom::{Aabb, Frustum, Ray, Relation, Sphere};
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 // The sphere tests are exact: whether `|p - q| <= r1 + r2` is decided for the
 // real numbers the `f32` inputs denote, at every magnitude. A fast `f64`
@@ -31,7 +31,7 @@ pub(crate) fn within(p: Vec3, q: Vec3, r1: f32, r2: f32) -> bool {
     let d2f = d.length_squared();
     let rsf = r1 + r2;
     let rs2f = rsf * rsf;
-    let marginf = 1e-5 * (d2f + rs2f) + 1e-35;
+    let marginf = f32_margin(d2f, rs2f);
     if d2f < rs2f - marginf {
         return true;
     }
@@ -51,6 +51,59 @@ pub(crate) fn within(p: Vec3, q: Vec3, r1: f32, r2: f32) -> bool {
     } else {
         super::exact::within(a, b, r1 as f64, r2 as f64)
     }
+}
+
+/// Rounding margin of the `f32` filter of [`within`] for computed squares `d2f`
+/// (distance) and `rs2f` (radius sum).
+#[inline(always)]
+fn f32_margin(d2f: f32, rs2f: f32) -> f32 {
+    1e-5 * (d2f + rs2f) + 1e-35
+}
+
+/// Conservative pre-test for batched sphere–sphere loops, on plain coordinates
+/// (structure-of-arrays callers): `false` only if [`sphere_sphere`] is `false`
+/// for the spheres `(a, ar)` and `(b, br)`, so those need no exact test; `true`
+/// means "run [`sphere_sphere`]". It is the rejection step of `sphere_sphere`'s
+/// own `f32` filter (same operations, so the same rounding; a square is
+/// unchanged by the sign of the difference), branch-free so that loops over
+/// many spheres vectorize. O(1).
+#[allow(clippy::too_many_arguments, clippy::neg_cmp_op_on_partial_ord)]
+#[inline(always)]
+pub fn sphere_sphere_candidate(
+    ax: f32,
+    ay: f32,
+    az: f32,
+    ar: f32,
+    bx: f32,
+    by: f32,
+    bz: f32,
+    br: f32,
+) -> bool {
+    let (dx, dy, dz) = (ax - bx, ay - by, az - bz);
+    let d2f = dx * dx + dy * dy + dz * dz;
+    let rsf = ar + br;
+    let rs2f = rsf * rsf;
+    // Written as `!(>)` so that a NaN or an overflow to ∞ stays a candidate,
+    // exactly as `within` falls through to `f64` then.
+    !(d2f > rs2f + f32_margin(d2f, rs2f))
+}
+
+/// [`sphere_sphere_candidate`] for four spheres at once, given lane by lane
+/// (`x[j]`, `y[j]`, `z[j]`, `r[j]` for sphere `j`), against `s`: bit `j` of the
+/// result is set when sphere `j` is a candidate, i.e. clear only if
+/// [`sphere_sphere`] is `false` for it. The same operations as the scalar
+/// pre-test in each SIMD lane, so the same rounding. O(1).
+#[inline(always)]
+pub fn sphere_sphere_candidates4(x: Vec4, y: Vec4, z: Vec4, r: Vec4, s: &Sphere) -> u32 {
+    let dx = x - Vec4::splat(s.center.x);
+    let dy = y - Vec4::splat(s.center.y);
+    let dz = z - Vec4::splat(s.center.z);
+    let d2f = dx * dx + dy * dy + dz * dz;
+    let rsf = r + Vec4::splat(s.radius);
+    let rs2f = rsf * rsf;
+    let margin = Vec4::splat(1e-5) * (d2f + rs2f) + Vec4::splat(1e-35);
+    // `>` is false for NaN, so NaN and ∞ lanes stay candidates, as in the scalar test.
+    !d2f.cmpgt(rs2f + margin).bitmask() & 0xF
 }
 
 /// Sphere–sphere: `|c1 - c2| <= r1 + r2`, decided exactly (see the module).
@@ -257,6 +310,49 @@ pub fn distance_squared(a: Vec3, b: Vec3) -> f32 {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn candidates4_agree_with_the_scalar_pre_test_and_never_drop_an_overlap() {
+        // Near-tangent, overlapping, far, huge and tiny spheres.
+        let mut st = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            st ^= st << 13;
+            st ^= st >> 7;
+            st ^= st << 17;
+            (st >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for k in 0..20_000 {
+            let scale = [1e-3f32, 1.0, 1e3, 1e30][k % 4];
+            let s = Sphere::new(Vec3::new(next(), next(), next()) * scale, next() * scale);
+            let mut lanes = [Sphere::default(); 4];
+            for l in &mut lanes {
+                let dir = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize_or(Vec3::X);
+                let r = next() * scale;
+                // Around tangency: distance = (r + s.r) * (1 +- small).
+                let t = (r + s.radius) * (1.0 + (next() - 0.5) * 1e-5);
+                *l = Sphere::new(s.center + dir * t, r);
+            }
+            let v = |f: fn(&Sphere) -> f32| Vec4::from_array(lanes.map(|l| f(&l)));
+            let mask = sphere_sphere_candidates4(
+                v(|l| l.center.x),
+                v(|l| l.center.y),
+                v(|l| l.center.z),
+                v(|l| l.radius),
+                &s,
+            );
+            for (j, l) in lanes.iter().enumerate() {
+                let c = l.center;
+                let scalar = sphere_sphere_candidate(
+                    c.x, c.y, c.z, l.radius, s.center.x, s.center.y, s.center.z, s.radius,
+                );
+                assert_eq!(mask >> j & 1 == 1, scalar, "{l:?} vs {s:?}");
+                if sphere_sphere(l, &s) {
+                    assert!(scalar, "overlap rejected: {l:?} vs {s:?}");
+                }
+            }
+        }
+    }
+
     use super::*;
     use glam::{vec3, Mat4};
 

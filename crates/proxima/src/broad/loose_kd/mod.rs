@@ -7,11 +7,14 @@
 //! creation, placing and swap-removing objects),
 //! `update.rs` (removal and moves with climbing), `query.rs` (selection queries and
 //! the front-to-back ray search), `pairs.rs` (node-vs-node self collision),
+//! `pairs_par.rs` (the same walk split into rayon tasks, feature `parallel`),
 //! `validate.rs`, `stats.rs`, `visit.rs` (read-only node walk for pictures).
 
 mod insert;
 mod node;
 mod pairs;
+#[cfg(feature = "parallel")]
+mod pairs_par;
 mod query;
 mod stats;
 mod update;
@@ -87,7 +90,7 @@ struct Loc {
 ///
 /// # Costs
 ///
-/// Memory: one node per occupied cell (`size_of` ≈ 100 bytes) whose objects
+/// Memory: one node per occupied cell (`size_of` = 128 bytes, one cache-line-aligned block) whose objects
 /// (sphere, handle, payload) are stored contiguously in a vector owned by the node,
 /// plus one small arena slot per object giving its node and position. Nodes live in
 /// a pooled arena with a free list and the vectors of freed nodes are recycled, so

@@ -20,8 +20,31 @@ pub(super) struct Slot<T> {
 }
 
 /// A tree node (seed `NODE`), flat in a [`Pool`](crate::arena::Pool).
+///
+/// Laid out by hand (`repr(C)`, one cache line per node start): the fields the
+/// pair walk reads at every node (objects, children, split) come first, so a
+/// visit touches one line of the node; the boxes, read by insertion, moves and
+/// queries, follow.
 #[derive(Clone, Debug)]
+#[repr(C, align(64))]
 pub(super) struct Node<T> {
+    /// The objects attached here, in no particular order (removal swaps the last
+    /// one into the hole). The vector is recycled through the tree's spare list
+    /// when the node is freed, so steady-state moves do not allocate.
+    pub slots: Vec<Slot<T>>,
+    /// `[negative, positive]`.
+    pub child: [u32; 2],
+    /// Centre of `bbox` on the split axis.
+    pub m: f32,
+    /// Border half-width `min(R_max, extent_axis(bbox) · d / 4)`.
+    pub h: f32,
+    /// Split axis: the longest of `bbox` (ties to the lower index, as in the seed).
+    pub axis: u8,
+    pub depth: u8,
+    /// The parent's `h` (∞ at the root): a sphere is routed here only if `r < h_up`.
+    /// `h` never grows downwards, so this is the smallest `h` on the path.
+    pub h_up: f32,
+    pub parent: u32,
     /// The seed's box `B`: the world box, narrowed by one face per split above.
     pub bbox: Aabb,
     /// Where the centres of spheres routed through this node lie: per split above,
@@ -29,23 +52,6 @@ pub(super) struct Node<T> {
     /// `cell.max` inclusive). Unsplit faces are infinite: the rule ignores the
     /// world box. Lets a move check in O(1) that the placement is unchanged.
     pub cell: Aabb,
-    /// Centre of `bbox` on the split axis.
-    pub m: f32,
-    /// Border half-width `min(R_max, extent_axis(bbox) · d / 4)`.
-    pub h: f32,
-    /// The parent's `h` (∞ at the root): a sphere is routed here only if `r < h_up`.
-    /// `h` never grows downwards, so this is the smallest `h` on the path.
-    pub h_up: f32,
-    pub parent: u32,
-    /// `[negative, positive]`.
-    pub child: [u32; 2],
-    /// The objects attached here, in no particular order (removal swaps the last
-    /// one into the hole). The vector is recycled through the tree's spare list
-    /// when the node is freed, so steady-state moves do not allocate.
-    pub slots: Vec<Slot<T>>,
-    /// Split axis: the longest of `bbox` (ties to the lower index, as in the seed).
-    pub axis: u8,
-    pub depth: u8,
 }
 
 impl<T> Node<T> {

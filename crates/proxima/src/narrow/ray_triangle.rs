@@ -2,7 +2,7 @@
 //! Ray/Triangle Intersection", JCGT 2013), evaluated in `f64`.
 
 use crate::geom::Ray;
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec3A};
 
 /// Where a ray meets a triangle: parameter `t` and barycentrics `(u, v)` with the
 /// hit point `(1-u-v)·a + u·b + v·c`.
@@ -71,6 +71,76 @@ pub fn ray_triangle(ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit> {
     })
 }
 
+/// A ray prepared for the `f32` pre-test [`RayFilter::may_hit`] of many triangles.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RayFilter {
+    o: Vec3A,
+    d: Vec3A,
+    /// `|d|₁`.
+    d1: f32,
+}
+
+/// Relative error factor of the `f32` Möller–Trumbore edge functions (64 ε; the
+/// analysis below needs 26 ε).
+const FILTER_EPS: f32 = 64.0 * f32::EPSILON;
+/// Covers the `f64` test's own rounding (relative `2^-48` at worst) when a
+/// triangle is tiny compared with its distance to the ray origin.
+const FILTER_FAR: f32 = 1.0 / (1u64 << 40) as f32;
+
+impl RayFilter {
+    /// Prepares `ray`.
+    #[inline]
+    pub(crate) fn new(ray: &Ray) -> RayFilter {
+        let d = Vec3A::from(ray.dir);
+        RayFilter {
+            o: Vec3A::from(ray.origin),
+            d,
+            d1: d.abs().element_sum(),
+        }
+    }
+
+    /// A conservative `f32` reject test: false only if [`ray_triangle`] certainly
+    /// misses the triangle `v0, v1, v2` (whatever `max_t`); true means "maybe", and
+    /// the caller runs the exact test. `e1 = v0 - v1`, `e2 = v2 - v0`,
+    /// `ng = e1 × e2` and `e_l1 = max(|e1|₁, |e2|₁)` as computed in `f32`
+    /// ([`prepare_triangle`]).
+    ///
+    /// Möller–Trumbore's unnormalized barycentrics `U = (d × c)·e2`,
+    /// `V = (d × c)·e1` and `W = ng·d − U − V` (with `c = v0 − o`) are, in exact
+    /// arithmetic, the three edge functions of the watertight test up to one common
+    /// factor; the ray misses iff two of them have strictly opposite signs. Each
+    /// is a sum of products of three coordinates, so its `f32` rounding error is at
+    /// most `26 ε · |d|₁ · e · (e + |c|₁)` (with `e` the edges' L1 bound; this
+    /// includes the rounding of `c`, of the edges and of `ng`). The test rejects
+    /// only when one value is below `−τ` and another above `τ`, with `τ` that bound
+    /// times 2.5 plus a term for the `f64` test's own rounding, so the `f64` test
+    /// sees the same strict sign disagreement and returns `None` too. Overflow to
+    /// infinity or NaN makes `τ` infinite or the comparisons false: no rejection.
+    /// Costs about a fifth of the `f64` test.
+    #[inline(always)]
+    pub(crate) fn may_hit(&self, v0: Vec3A, e1: Vec3A, e2: Vec3A, ng: Vec3A, e_l1: f32) -> bool {
+        let c = v0 - self.o;
+        let r = self.d.cross(c);
+        let u = r.dot(e2);
+        let v = r.dot(e1);
+        let w = ng.dot(self.d) - u - v;
+        let c1 = c.abs().element_sum();
+        let tau = self.d1 * (FILTER_EPS * e_l1 * (e_l1 + c1) + FILTER_FAR * c1 * c1);
+        let lo = u.min(v).min(w);
+        let hi = u.max(v).max(w);
+        !(lo < -tau && hi > tau)
+    }
+}
+
+/// The `f32` data of [`RayFilter::may_hit`] for triangle `t`: `(e1, e2, ng, e_l1)`.
+#[inline(always)]
+pub(crate) fn prepare_triangle(t: &[Vec3A; 3]) -> (Vec3A, Vec3A, Vec3A, f32) {
+    let e1 = t[0] - t[1];
+    let e2 = t[2] - t[0];
+    let l1 = e1.abs().element_sum().max(e2.abs().element_sum());
+    (e1, e2, e1.cross(e2), l1)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -91,6 +161,52 @@ mod tests {
         assert!(ray_triangle(&short, &tri).is_none());
         // Degenerate triangle.
         assert!(ray_triangle(&down(0.0, 0.0), &[Vec3::ZERO; 3]).is_none());
+    }
+
+    /// The `f32` pre-test never rejects a triangle the exact test hits, on rays
+    /// aimed at corners, edges and interiors (where rounding matters most), from
+    /// near and far, at all scales.
+    #[test]
+    fn filter_never_rejects_a_hit() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        let (mut hits, mut rejected) = (0, 0);
+        for i in 0..200_000 {
+            let scale = 10f32.powi(rng.gen_range(-3..4));
+            let p = |rng: &mut rand_pcg::Pcg64| {
+                Vec3::new(
+                    rng.gen_range(-1.0..1.0),
+                    rng.gen_range(-1.0..1.0),
+                    rng.gen_range(-1.0..1.0),
+                ) * scale
+            };
+            let tri = [p(&mut rng), p(&mut rng), p(&mut rng)];
+            let far = if i % 3 == 0 { 1000.0 } else { 3.0 };
+            let o = p(&mut rng) * far;
+            // Aim at a corner, an edge point, an interior point or anywhere.
+            let (a, b) = (rng.gen_range(0.0..1.0f32), rng.gen_range(0.0..1.0f32));
+            let target = match i % 5 {
+                0 => tri[i % 3],
+                1 => tri[0] + (tri[1] - tri[0]) * a,
+                2 => tri[1] + (tri[2] - tri[1]) * a,
+                3 => tri[0] + (tri[1] - tri[0]) * a * (1.0 - b) + (tri[2] - tri[0]) * b * (1.0 - a),
+                _ => p(&mut rng),
+            };
+            let ray = Ray::new(o, target - o);
+            if ray.dir == Vec3::ZERO {
+                continue;
+            }
+            let exact = ray_triangle(&ray, &tri);
+            let (e1, e2, ng, l1) = prepare_triangle(&tri.map(Vec3A::from));
+            let maybe = RayFilter::new(&ray).may_hit(Vec3A::from(tri[0]), e1, e2, ng, l1);
+            if exact.is_some() {
+                hits += 1;
+                assert!(maybe, "rejected a hit: {ray:?} {tri:?}");
+            } else if !maybe {
+                rejected += 1;
+            }
+        }
+        assert!(hits > 50_000 && rejected > 10_000, "{hits} {rejected}");
     }
 
     #[test]

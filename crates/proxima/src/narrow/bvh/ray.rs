@@ -46,6 +46,11 @@ impl<BV: BoundingVolume> Bvh<BV> {
     fn cast(&self, mesh: &TriMesh, ray: &Ray, any: bool) -> Result<Option<RayHit>> {
         ray.validate()?;
         self.check_vertices(mesh.vertices().len())?;
+        Ok(self.cast_valid(mesh, ray, any))
+    }
+
+    /// The cast of a validated ray on a mesh of the right size.
+    pub(crate) fn cast_valid(&self, mesh: &TriMesh, ray: &Ray, any: bool) -> Option<RayHit> {
         let scale = 2.0 * (self.coord_bound + ray.origin.abs().element_sum());
         let slack = slack_for(scale, 0.0);
         let verts = mesh.vertices();
@@ -76,7 +81,7 @@ impl<BV: BoundingVolume> Bvh<BV> {
                                 v: h.v,
                             });
                             if any {
-                                return Ok(best);
+                                return best;
                             }
                         }
                     }
@@ -102,6 +107,6 @@ impl<BV: BoundingVolume> Bvh<BV> {
                 (None, None) => {}
             }
         }
-        Ok(best)
+        best
     }
 }

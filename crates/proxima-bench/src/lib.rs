@@ -16,9 +16,13 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod bvh_peer;
+pub mod obvhs_peer;
 pub mod parry;
+pub mod parry_mesh_peer;
 pub mod registry;
 pub mod report;
 pub mod run;
 pub mod structure;
+pub mod w6;
 pub mod workloads;

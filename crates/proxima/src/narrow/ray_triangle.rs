@@ -26,49 +26,78 @@ pub struct TriangleHit {
 /// A triangle seen exactly edge-on (zero sheared area), including every degenerate
 /// triangle, is never hit. O(1).
 pub fn ray_triangle(ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit> {
-    let d = ray.dir.as_dvec3();
-    let o = ray.origin.as_dvec3();
-    // kz: the dominant axis of the direction; kx, ky keep the winding.
-    let ad = d.abs();
-    let kz = if ad.x >= ad.y && ad.x >= ad.z {
-        0
-    } else if ad.y >= ad.z {
-        1
-    } else {
-        2
-    };
-    let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
-    if d[kz] < 0.0 {
-        std::mem::swap(&mut kx, &mut ky);
+    WoopRay::new(ray).hit(tri)
+}
+
+/// The per-ray part of [`ray_triangle`] (the dominant axis, the shear and the
+/// `f64` origin), computed once for many triangles: `WoopRay::new(ray).hit(tri)`
+/// *is* `ray_triangle(ray, tri)`, bit for bit.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WoopRay {
+    o: DVec3,
+    k: [usize; 3],
+    s: DVec3,
+    max_t: f64,
+}
+
+impl WoopRay {
+    /// Prepares `ray` (a valid ray).
+    #[inline]
+    pub(crate) fn new(ray: &Ray) -> WoopRay {
+        let d = ray.dir.as_dvec3();
+        // kz: the dominant axis of the direction; kx, ky keep the winding.
+        let ad = d.abs();
+        let kz = if ad.x >= ad.y && ad.x >= ad.z {
+            0
+        } else if ad.y >= ad.z {
+            1
+        } else {
+            2
+        };
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let sz = 1.0 / d[kz];
+        WoopRay {
+            o: ray.origin.as_dvec3(),
+            k: [kx, ky, kz],
+            s: DVec3::new(d[kx] * sz, d[ky] * sz, sz),
+            max_t: ray.max_t as f64,
+        }
     }
-    let sz = 1.0 / d[kz];
-    let sx = d[kx] * sz;
-    let sy = d[ky] * sz;
-    let rel = |p: Vec3| -> DVec3 {
-        let q = p.as_dvec3() - o;
-        DVec3::new(q[kx] - sx * q[kz], q[ky] - sy * q[kz], sz * q[kz])
-    };
-    let (a, b, c) = (rel(tri[0]), rel(tri[1]), rel(tri[2]));
-    let u = c.x * b.y - c.y * b.x;
-    let v = a.x * c.y - a.y * c.x;
-    let w = b.x * a.y - b.y * a.x;
-    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-        return None;
+
+    /// The test of one triangle (see [`ray_triangle`]).
+    #[inline]
+    pub(crate) fn hit(&self, tri: &[Vec3; 3]) -> Option<TriangleHit> {
+        let [kx, ky, kz] = self.k;
+        let (sx, sy, sz) = (self.s.x, self.s.y, self.s.z);
+        let rel = |p: Vec3| -> DVec3 {
+            let q = p.as_dvec3() - self.o;
+            DVec3::new(q[kx] - sx * q[kz], q[ky] - sy * q[kz], sz * q[kz])
+        };
+        let (a, b, c) = (rel(tri[0]), rel(tri[1]), rel(tri[2]));
+        let u = c.x * b.y - c.y * b.x;
+        let v = a.x * c.y - a.y * c.x;
+        let w = b.x * a.y - b.y * a.x;
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let t_scaled = u * a.z + v * b.z + w * c.z;
+        let t = t_scaled / det;
+        if t.is_nan() || t < 0.0 || t > self.max_t {
+            return None;
+        }
+        Some(TriangleHit {
+            t: t as f32,
+            u: (v / det) as f32,
+            v: (w / det) as f32,
+        })
     }
-    let det = u + v + w;
-    if det == 0.0 {
-        return None;
-    }
-    let t_scaled = u * a.z + v * b.z + w * c.z;
-    let t = t_scaled / det;
-    if t.is_nan() || t < 0.0 || t > ray.max_t as f64 {
-        return None;
-    }
-    Some(TriangleHit {
-        t: t as f32,
-        u: (v / det) as f32,
-        v: (w / det) as f32,
-    })
 }
 
 /// A ray prepared for the `f32` pre-test [`RayFilter::may_hit`] of many triangles.
@@ -117,18 +146,50 @@ impl RayFilter {
     /// sees the same strict sign disagreement and returns `None` too. Overflow to
     /// infinity or NaN makes `τ` infinite or the comparisons false: no rejection.
     /// Costs about a fifth of the `f64` test.
+    ///
+    /// With `limit` (the ray's `max_t`, or the best hit so far) it also rejects a
+    /// triangle whose plane the ray certainly crosses behind the origin or beyond
+    /// `limit · (1 + 4ε)` (so a hit that would round to `limit` and win a tie is
+    /// kept): `t = (ng·c) / (ng·d)`, both dot products within `64 ε e² |c|₁` and
+    /// `64 ε e² |d|₁` of exact, used only when the sign of `ng·d` is certain; the
+    /// `2^-40 |c|₁²` terms cover the `f64` test's own numerator and determinant
+    /// errors with a factor `2^10` to spare, so it sees `t < 0` or `t > limit` too.
     #[inline(always)]
-    pub(crate) fn may_hit(&self, v0: Vec3A, e1: Vec3A, e2: Vec3A, ng: Vec3A, e_l1: f32) -> bool {
+    pub(crate) fn may_hit(
+        &self,
+        v0: Vec3A,
+        e1: Vec3A,
+        e2: Vec3A,
+        ng: Vec3A,
+        e_l1: f32,
+        limit: f32,
+    ) -> bool {
         let c = v0 - self.o;
         let r = self.d.cross(c);
         let u = r.dot(e2);
         let v = r.dot(e1);
-        let w = ng.dot(self.d) - u - v;
+        let det = ng.dot(self.d);
+        let w = det - u - v;
         let c1 = c.abs().element_sum();
-        let tau = self.d1 * (FILTER_EPS * e_l1 * (e_l1 + c1) + FILTER_FAR * c1 * c1);
+        let far = FILTER_FAR * c1 * c1;
+        let tau = self.d1 * (FILTER_EPS * e_l1 * (e_l1 + c1) + far);
         let lo = u.min(v).min(w);
         let hi = u.max(v).max(w);
-        !(lo < -tau && hi > tau)
+        if lo < -tau && hi > tau {
+            return false;
+        }
+        let e2l = FILTER_EPS * e_l1 * e_l1 + far;
+        let (tau_det, tau_num) = (e2l * self.d1, e2l * c1);
+        let a = det.abs();
+        if a > tau_det {
+            let b = if det < 0.0 { -ng.dot(c) } else { ng.dot(c) };
+            // Behind the origin, or beyond the limit (never for an infinite limit).
+            let l = limit * (1.0 + 4.0 * f32::EPSILON);
+            if b < -tau_num || b - l * a > tau_num + l * tau_det {
+                return false;
+            }
+        }
+        true
     }
 }
 
@@ -198,7 +259,8 @@ mod tests {
             }
             let exact = ray_triangle(&ray, &tri);
             let (e1, e2, ng, l1) = prepare_triangle(&tri.map(Vec3A::from));
-            let maybe = RayFilter::new(&ray).may_hit(Vec3A::from(tri[0]), e1, e2, ng, l1);
+            let maybe =
+                RayFilter::new(&ray).may_hit(Vec3A::from(tri[0]), e1, e2, ng, l1, f32::INFINITY);
             if exact.is_some() {
                 hits += 1;
                 assert!(maybe, "rejected a hit: {ray:?} {tri:?}");

@@ -4,7 +4,7 @@ use super::ray::RayHit;
 use super::ray_tree::{RayBvh, RayNode};
 use crate::geom::{Ray, Segment};
 use crate::narrow::bv::BoundingVolume;
-use crate::narrow::ray_triangle::{ray_triangle, RayFilter};
+use crate::narrow::ray_triangle::{RayFilter, WoopRay};
 use crate::Result;
 use glam::{Vec3, Vec3A};
 
@@ -13,7 +13,7 @@ use glam::{Vec3, Vec3A};
 const WIDEN: f32 = 4.0 * f32::EPSILON;
 
 /// Slots of the traversal stack kept on the machine stack (deeper trees spill).
-const STACK: usize = 64;
+const STACK: usize = 32;
 
 /// A LIFO of `(node, entry t)` on the machine stack, spilling to the heap only for
 /// trees deeper than [`STACK`].
@@ -115,6 +115,7 @@ impl RayBvh {
         entry: impl Fn(&RayNode, f32) -> Option<f32>,
     ) -> Option<RayHit> {
         let filter = RayFilter::new(ray);
+        let woop = WoopRay::new(ray);
         let mut best: Option<RayHit> = None;
         let mut limit = ray.max_t;
         let mut stack = Stack::new();
@@ -156,10 +157,10 @@ impl RayBvh {
                     let t = &self.tris[k];
                     let e1 = t.v[0] - t.v[1];
                     let e2 = t.v[2] - t.v[0];
-                    if !filter.may_hit(t.v[0], e1, e2, Vec3A::from_vec4(t.ng), t.ng.w) {
+                    if !filter.may_hit(t.v[0], e1, e2, Vec3A::from_vec4(t.ng), t.ng.w, limit) {
                         continue;
                     }
-                    let Some(h) = ray_triangle(ray, &t.v.map(Vec3::from)) else {
+                    let Some(h) = woop.hit(&t.v.map(Vec3::from)) else {
                         continue;
                     };
                     let id = self.ids[k];

@@ -1,12 +1,12 @@
 //! Ray and segment casts against a [`RayBvh`].
 
 use super::ray::RayHit;
-use super::ray_tree::{RayBvh, RayNode};
+use super::ray_tree::{RayBvh, RayNode, LEAF};
 use crate::geom::{Ray, Segment};
 use crate::narrow::bv::BoundingVolume;
 use crate::narrow::ray_triangle::{RayFilter, WoopRay};
 use crate::Result;
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 
 /// Relative widening of the box entry and exit parameters: the subtraction, the
 /// rounded reciprocal and the product each round by at most ε/2.
@@ -56,16 +56,47 @@ impl Stack {
     }
 }
 
-/// Entry parameter of the ray into node `n` if it enters at or before `limit`:
-/// slab test with the precomputed inverse direction `inv` (all finite), the
-/// interval widened by [`WIDEN`] so rounding never culls a box the ray touches.
+/// The ray in the form the 4-wide slab test wants: origin and inverse direction
+/// splatted per axis.
+struct Slabs {
+    o: [Vec4; 3],
+    inv: [Vec4; 3],
+}
+
+/// Entry parameters of the ray into the four lanes of `n` and the mask of lanes it
+/// enters at or before `limit`: slab test with the precomputed inverse direction
+/// (all finite), the interval widened by [`WIDEN`] so rounding never culls a box
+/// the ray touches. Only vertical SIMD operations.
 #[inline(always)]
-fn entry_fast(n: &RayNode, o: Vec3A, inv: Vec3A, limit: f32) -> Option<f32> {
-    let t0 = (Vec3A::from_vec4(n.lo) - o) * inv;
-    let t1 = (Vec3A::from_vec4(n.hi) - o) * inv;
-    let near = t0.min(t1).max_element().max(0.0) * (1.0 - WIDEN);
-    let far = t0.max(t1).min_element() * (1.0 + WIDEN);
-    (near <= far && near <= limit).then_some(near)
+fn entry4(n: &RayNode, s: &Slabs, limit: f32) -> (Vec4, u32) {
+    let mut near = Vec4::ZERO;
+    let mut far = Vec4::splat(limit);
+    for a in 0..3 {
+        let t0 = (n.lo[a] - s.o[a]) * s.inv[a];
+        let t1 = (n.hi[a] - s.o[a]) * s.inv[a];
+        near = near.max(t0.min(t1));
+        far = far.min(t0.max(t1));
+    }
+    let near = near * (1.0 - WIDEN);
+    // `limit` was in `far` before widening: a box entered exactly at the best
+    // hit is kept (a tie may go to a smaller triangle index).
+    let far = far * (1.0 + WIDEN);
+    (near, near.cmple(far).bitmask() & ((1u32 << n.len) - 1))
+}
+
+/// [`entry4`] for a ray with a zero or subnormal direction component: the general
+/// slab clip of each lane, which tests the origin against a slab the ray runs
+/// parallel to.
+fn entry4_general(n: &RayNode, ray: &Ray, limit: f32) -> (Vec4, u32) {
+    let mut near = Vec4::ZERO;
+    let mut mask = 0;
+    for k in 0..n.len as usize {
+        if let Some(t) = n.lane(k).ray_entry(ray, 0.0).filter(|&t| t <= limit) {
+            near[k] = t;
+            mask |= 1 << k;
+        }
+    }
+    (near, mask)
 }
 
 impl RayBvh {
@@ -92,68 +123,67 @@ impl RayBvh {
     /// The cast of a validated ray.
     pub(crate) fn cast_valid(&self, ray: &Ray, any: bool) -> Option<RayHit> {
         let inv = Vec3A::ONE / Vec3A::from(ray.dir);
+        let root = self.root.ray_entry(ray, 0.0)?;
+        if root > ray.max_t {
+            return None;
+        }
         if inv.is_finite() {
-            let o = Vec3A::from(ray.origin);
-            self.traverse(ray, any, |n, limit| entry_fast(n, o, inv, limit))
+            let s = Slabs {
+                o: [0, 1, 2].map(|a| Vec4::splat(ray.origin[a])),
+                inv: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
+            };
+            self.traverse(ray, any, |n, limit| entry4(n, &s, limit))
         } else {
-            // A zero (or subnormal) direction component: the general slab clip,
-            // which tests the origin against a slab the ray runs parallel to.
-            self.traverse(ray, any, |n, limit| {
-                n.aabb().ray_entry(ray, 0.0).filter(|&t| t <= limit)
-            })
+            self.traverse(ray, any, |n, limit| entry4_general(n, ray, limit))
         }
     }
 
-    /// Front-to-back descent: at each internal node both children are tested, the
-    /// nearer is visited next and the farther stacked with its entry `t`; a node
-    /// entered beyond the best hit so far is skipped.
+    /// Front-to-back descent: at each node the four lanes are tested at once, the
+    /// nearest entered child is visited next and the others are stacked, farthest
+    /// first, with their entry `t`; a node entered beyond the best hit so far is
+    /// skipped.
     #[inline(always)]
     fn traverse(
         &self,
         ray: &Ray,
         any: bool,
-        entry: impl Fn(&RayNode, f32) -> Option<f32>,
+        entry: impl Fn(&RayNode, f32) -> (Vec4, u32),
     ) -> Option<RayHit> {
         let filter = RayFilter::new(ray);
         let woop = WoopRay::new(ray);
         let mut best: Option<RayHit> = None;
         let mut limit = ray.max_t;
         let mut stack = Stack::new();
-        let mut cur = match entry(&self.nodes[0], limit) {
-            Some(_) => 0u32,
-            None => return None,
-        };
+        let mut cur = self.root_link;
         loop {
-            let n = &self.nodes[cur as usize];
-            let count = n.count();
-            if count == 0 {
-                let c = n.link();
-                let a = entry(&self.nodes[c as usize], limit);
-                let b = entry(&self.nodes[c as usize + 1], limit);
-                match (a, b) {
-                    (Some(ta), Some(tb)) => {
-                        if ta <= tb {
-                            stack.push((c + 1, tb));
-                            cur = c;
-                        } else {
-                            stack.push((c, ta));
-                            cur = c + 1;
+            if cur & LEAF == 0 {
+                let n = &self.nodes[cur as usize];
+                let (near, mut mask) = entry(n, limit);
+                if mask != 0 {
+                    // Entered lanes sorted by entry t (at most four: insertion).
+                    let mut hits = [(0u32, 0.0f32); 4];
+                    let mut k = 0;
+                    while mask != 0 {
+                        let lane = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let item = (n.child[lane], near[lane]);
+                        let mut j = k;
+                        while j > 0 && hits[j - 1].1 > item.1 {
+                            hits[j] = hits[j - 1];
+                            j -= 1;
                         }
-                        continue;
+                        hits[j] = item;
+                        k += 1;
                     }
-                    (Some(_), None) => {
-                        cur = c;
-                        continue;
+                    for h in hits[1..k].iter().rev() {
+                        stack.push(*h);
                     }
-                    (None, Some(_)) => {
-                        cur = c + 1;
-                        continue;
-                    }
-                    (None, None) => {}
+                    cur = hits[0].0;
+                    continue;
                 }
             } else {
-                let s = n.link() as usize;
-                for k in s..s + count as usize {
+                let [s, count] = self.leaves[(cur & !LEAF) as usize];
+                for k in s as usize..(s + count) as usize {
                     let t = &self.tris[k];
                     let e1 = t.v[0] - t.v[1];
                     let e2 = t.v[2] - t.v[0];

@@ -13,11 +13,11 @@ use glam::{Vec3, Vec3A, Vec4};
 const WIDEN: f32 = 4.0 * f32::EPSILON;
 
 /// Slots of the traversal stack kept on the machine stack (deeper trees spill).
-const STACK: usize = 32;
+const STACK: usize = 16;
 
 /// A LIFO of `(node, entry t)` on the machine stack, spilling to the heap only for
 /// trees deeper than [`STACK`].
-struct Stack {
+pub(crate) struct Stack {
     items: [(u32, f32); STACK],
     len: usize,
     spill: Vec<(u32, f32)>,
@@ -25,7 +25,7 @@ struct Stack {
 
 impl Stack {
     #[inline(always)]
-    fn new() -> Stack {
+    pub(crate) fn new() -> Stack {
         Stack {
             items: [(0, 0.0); STACK],
             len: 0,
@@ -34,7 +34,7 @@ impl Stack {
     }
 
     #[inline(always)]
-    fn push(&mut self, x: (u32, f32)) {
+    pub(crate) fn push(&mut self, x: (u32, f32)) {
         if self.len < STACK {
             self.items[self.len] = x;
             self.len += 1;
@@ -44,7 +44,7 @@ impl Stack {
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, f32)> {
+    pub(crate) fn pop(&mut self) -> Option<(u32, f32)> {
         if let Some(x) = self.spill.pop() {
             return Some(x);
         }
@@ -57,25 +57,31 @@ impl Stack {
 }
 
 /// The ray in the form the 4-wide slab test wants: origin and inverse direction
-/// splatted per axis.
+/// splatted per axis, and which side of each slab the ray enters by.
 struct Slabs {
     o: [Vec4; 3],
     inv: [Vec4; 3],
+    /// `neg[a]`: the direction is negative on axis `a` (enters by the max side).
+    neg: [bool; 3],
 }
 
 /// Entry parameters of the ray into the four lanes of `n` and the mask of lanes it
 /// enters at or before `limit`: slab test with the precomputed inverse direction
-/// (all finite), the interval widened by [`WIDEN`] so rounding never culls a box
-/// the ray touches. Only vertical SIMD operations.
+/// (all finite) and the near/far side of each slab chosen once per ray by the
+/// direction's signs, the interval widened by [`WIDEN`] so rounding never culls a
+/// box the ray touches. Only vertical SIMD operations.
 #[inline(always)]
 fn entry4(n: &RayNode, s: &Slabs, limit: f32) -> (Vec4, u32) {
     let mut near = Vec4::ZERO;
     let mut far = Vec4::splat(limit);
     for a in 0..3 {
-        let t0 = (n.lo[a] - s.o[a]) * s.inv[a];
-        let t1 = (n.hi[a] - s.o[a]) * s.inv[a];
-        near = near.max(t0.min(t1));
-        far = far.min(t0.max(t1));
+        let (np, fp) = if s.neg[a] {
+            (n.hi[a], n.lo[a])
+        } else {
+            (n.lo[a], n.hi[a])
+        };
+        near = near.max((np - s.o[a]) * s.inv[a]);
+        far = far.min((fp - s.o[a]) * s.inv[a]);
     }
     let near = near * (1.0 - WIDEN);
     // `limit` was in `far` before widening: a box entered exactly at the best
@@ -123,14 +129,18 @@ impl RayBvh {
     /// The cast of a validated ray.
     pub(crate) fn cast_valid(&self, ray: &Ray, any: bool) -> Option<RayHit> {
         let inv = Vec3A::ONE / Vec3A::from(ray.dir);
-        let root = self.root.ray_entry(ray, 0.0)?;
-        if root > ray.max_t {
-            return None;
+        if self.root_link & LEAF != 0 || !inv.is_finite() {
+            // (Otherwise the root node's lanes are the first test.)
+            let root = self.root.ray_entry(ray, 0.0)?;
+            if root > ray.max_t {
+                return None;
+            }
         }
         if inv.is_finite() {
             let s = Slabs {
                 o: [0, 1, 2].map(|a| Vec4::splat(ray.origin[a])),
                 inv: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
+                neg: [0, 1, 2].map(|a| inv[a] < 0.0),
             };
             self.traverse(ray, any, |n, limit| entry4(n, &s, limit))
         } else {
@@ -150,7 +160,8 @@ impl RayBvh {
         entry: impl Fn(&RayNode, f32) -> (Vec4, u32),
     ) -> Option<RayHit> {
         let filter = RayFilter::new(ray);
-        let woop = WoopRay::new(ray);
+        // The exact test's per-ray setup, on the first triangle that needs it.
+        let mut woop: Option<WoopRay> = None;
         let mut best: Option<RayHit> = None;
         let mut limit = ray.max_t;
         let mut stack = Stack::new();
@@ -190,7 +201,8 @@ impl RayBvh {
                     if !filter.may_hit(t.v[0], e1, e2, Vec3A::from_vec4(t.ng), t.ng.w, limit) {
                         continue;
                     }
-                    let Some(h) = woop.hit(&t.v.map(Vec3::from)) else {
+                    let w = woop.get_or_insert_with(|| WoopRay::new(ray));
+                    let Some(h) = w.hit(&t.v.map(Vec3::from)) else {
                         continue;
                     };
                     let id = self.ids[k];

@@ -34,7 +34,10 @@ pub fn ray_triangle(ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit> {
 /// *is* `ray_triangle(ray, tri)`, bit for bit.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct WoopRay {
+    /// The origin, permuted to `(kx, ky, kz)`.
     o: DVec3,
+    /// The axis permutation `(kx, ky, kz)` (each `< 3`; masked by 3 when used, so
+    /// indexing a 4-array needs no bounds check).
     k: [usize; 3],
     s: DVec3,
     max_t: f64,
@@ -59,8 +62,9 @@ impl WoopRay {
             std::mem::swap(&mut kx, &mut ky);
         }
         let sz = 1.0 / d[kz];
+        let o = ray.origin.as_dvec3();
         WoopRay {
-            o: ray.origin.as_dvec3(),
+            o: DVec3::new(o[kx], o[ky], o[kz]),
             k: [kx, ky, kz],
             s: DVec3::new(d[kx] * sz, d[ky] * sz, sz),
             max_t: ray.max_t as f64,
@@ -70,11 +74,14 @@ impl WoopRay {
     /// The test of one triangle (see [`ray_triangle`]).
     #[inline]
     pub(crate) fn hit(&self, tri: &[Vec3; 3]) -> Option<TriangleHit> {
-        let [kx, ky, kz] = self.k;
+        let (kx, ky, kz) = (self.k[0] & 3, self.k[1] & 3, self.k[2] & 3);
         let (sx, sy, sz) = (self.s.x, self.s.y, self.s.z);
+        // Translate to the origin, permute, shear: the same operations on the same
+        // values whatever the order, so the result is the same bit for bit.
         let rel = |p: Vec3| -> DVec3 {
-            let q = p.as_dvec3() - self.o;
-            DVec3::new(q[kx] - sx * q[kz], q[ky] - sy * q[kz], sz * q[kz])
+            let p = p.extend(0.0).to_array();
+            let q = DVec3::new(p[kx] as f64, p[ky] as f64, p[kz] as f64) - self.o;
+            DVec3::new(q.x - sx * q.z, q.y - sy * q.z, sz * q.z)
         };
         let (a, b, c) = (rel(tri[0]), rel(tri[1]), rel(tri[2]));
         let u = c.x * b.y - c.y * b.x;

@@ -128,19 +128,21 @@ impl RayBvh {
 
     /// The cast of a validated ray.
     pub(crate) fn cast_valid(&self, ray: &Ray, any: bool) -> Option<RayHit> {
-        let inv = Vec3A::ONE / Vec3A::from(ray.dir);
-        if self.root_link & LEAF != 0 || !inv.is_finite() {
+        let inv = Vec3::ONE / ray.dir;
+        let finite = inv.is_finite();
+        if !finite || self.root_link & LEAF != 0 {
             // (Otherwise the root node's lanes are the first test.)
             let root = self.root.ray_entry(ray, 0.0)?;
             if root > ray.max_t {
                 return None;
             }
         }
-        if inv.is_finite() {
+        if finite {
+            let o = ray.origin;
             let s = Slabs {
-                o: [0, 1, 2].map(|a| Vec4::splat(ray.origin[a])),
-                inv: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
-                neg: [0, 1, 2].map(|a| inv[a] < 0.0),
+                o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
+                inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+                neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
             };
             self.traverse(ray, any, |n, limit| entry4(n, &s, limit))
         } else {
@@ -171,9 +173,16 @@ impl RayBvh {
                 let n = &self.nodes[cur as usize];
                 let (near, mut mask) = entry(n, limit);
                 if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if mask == 0 {
+                        // One lane entered (the common case): no sorting.
+                        cur = n.child[first];
+                        continue;
+                    }
                     // Entered lanes sorted by entry t (at most four: insertion).
-                    let mut hits = [(0u32, 0.0f32); 4];
-                    let mut k = 0;
+                    let mut hits = [(n.child[first], near[first]); 4];
+                    let mut k = 1;
                     while mask != 0 {
                         let lane = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
@@ -202,7 +211,7 @@ impl RayBvh {
                         continue;
                     }
                     let w = woop.get_or_insert_with(|| WoopRay::new(ray));
-                    let Some(h) = w.hit(&t.v.map(Vec3::from)) else {
+                    let Some(h) = w.hit(&[t.v[0].into(), t.v[1].into(), t.v[2].into()]) else {
                         continue;
                     };
                     let id = self.ids[k];

@@ -10,7 +10,9 @@
 //!   adapter over any `SpatialIndex<u32>`;
 //! - [`parry`]: the parry3d BVH adapter;
 //! - [`registry`]: the list of structures (one line per index);
-//! - [`run`]: timing and the pair-count ledger; [`report`]: tables and JSON.
+//! - [`run`]: timing and the pair-count ledger; [`report`]: tables and JSON;
+//! - [`w6`]: rays vs one mesh (its own runner, table and agreement check), with
+//!   the peers [`obvhs_peer`], [`bvh_peer`] and [`parry_mesh_peer`].
 //!
 //! Peers are dependencies of this crate only; the library stays light.
 #![forbid(unsafe_code)]

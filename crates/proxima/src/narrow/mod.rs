@@ -14,7 +14,7 @@ mod trimesh;
 pub use bv::{BoundingVolume, Kdop, Kdop14, Kdop18, Kdop26, Obb};
 pub use bvh::{
     check_pose, collide_all, collide_first, BuildOptions, Bvh, Collider, Contacts, CostCounters,
-    FirstContact, Node, RayHit, RotationUpdate, SplitRule,
+    FirstContact, Node, RayBvh, RayHit, RotationUpdate, SplitRule,
 };
 pub use prepared::PreparedTriangle;
 pub use ray_triangle::{ray_triangle, TriangleHit};

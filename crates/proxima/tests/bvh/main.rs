@@ -1,6 +1,7 @@
 //! BVH tests against brute force: structure, traversal, collision, ray casts, refit.
 
 mod meshes;
+mod rays;
 mod real;
 
 use meshes::*;

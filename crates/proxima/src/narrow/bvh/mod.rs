@@ -8,12 +8,18 @@
 //! - `traverse.rs`: the simultaneous descent of two trees (seed 003, Fig. 2);
 //! - `collide.rs`: mesh–mesh collision of two posed meshes with the cost counters;
 //! - `tri_cache.rs`: the per-query cache of prepared triangles;
-//! - `ray.rs`: ray and segment casts;
+//! - `ray.rs`: ray and segment casts; `ray_tree.rs` + `ray_cast.rs`: [`RayBvh`], the
+//!   same casts on a layout made for rays only; `par.rs`: parallel batches of them (feature
+//!   `parallel`);
 //! - `validate.rs`: the structural invariants.
 
 mod build;
 mod collide;
+#[cfg(feature = "parallel")]
+mod par;
 mod ray;
+mod ray_cast;
+mod ray_tree;
 mod refit;
 mod traverse;
 mod tree;
@@ -26,4 +32,5 @@ pub use collide::{
     RotationUpdate,
 };
 pub use ray::RayHit;
+pub use ray_tree::RayBvh;
 pub use tree::{Bvh, Node};

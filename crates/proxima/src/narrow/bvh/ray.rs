@@ -1,11 +1,13 @@
 //! Ray and segment casts against a mesh BVH.
 
+use super::ray_cast::Stack;
 use super::tree::Bvh;
 use crate::geom::{Ray, Segment};
 use crate::narrow::bv::{slack_for, BoundingVolume};
-use crate::narrow::ray_triangle::ray_triangle;
+use crate::narrow::ray_triangle::{prepare_triangle, RayFilter, WoopRay};
 use crate::narrow::TriMesh;
 use crate::Result;
+use glam::Vec3A;
 
 /// The closest hit of a ray on a mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -23,8 +25,10 @@ pub struct RayHit {
 impl<BV: BoundingVolume> Bvh<BV> {
     /// The closest hit of `ray` on `mesh` (smallest `t`; ties go to the smaller
     /// triangle index), with the watertight test of
-    /// [`ray_triangle`](crate::narrow::ray_triangle). Descends the nearer child
-    /// first and prunes nodes entered beyond the best hit: O(log n) typical.
+    /// [`ray_triangle`](crate::narrow::ray_triangle), after a conservative `f32`
+    /// pre-test that only skips triangles the exact test certainly misses. Descends
+    /// the nearer child first and prunes nodes entered beyond the best hit: O(log n)
+    /// typical. ([`RayBvh`](crate::narrow::RayBvh) gives the same answers faster.)
     ///
     /// Fails on an invalid ray (non-finite, zero direction, negative `max_t`) or a
     /// mesh whose vertex count differs from the tree's.
@@ -46,23 +50,38 @@ impl<BV: BoundingVolume> Bvh<BV> {
     fn cast(&self, mesh: &TriMesh, ray: &Ray, any: bool) -> Result<Option<RayHit>> {
         ray.validate()?;
         self.check_vertices(mesh.vertices().len())?;
+        Ok(self.cast_valid(mesh, ray, any))
+    }
+
+    /// The cast of a validated ray on a mesh of the right size.
+    pub(crate) fn cast_valid(&self, mesh: &TriMesh, ray: &Ray, any: bool) -> Option<RayHit> {
         let scale = 2.0 * (self.coord_bound + ray.origin.abs().element_sum());
         let slack = slack_for(scale, 0.0);
         let verts = mesh.vertices();
+        let filter = RayFilter::new(ray);
+        // The exact test's per-ray setup, on the first triangle that needs it.
+        let mut woop: Option<WoopRay> = None;
         let mut best: Option<RayHit> = None;
-        let mut stack: Vec<(u32, f32)> = Vec::with_capacity(64);
+        let mut limit = ray.max_t;
+        let mut stack = Stack::new();
         if let Some(t) = self.nodes[0].bv.ray_entry(ray, slack) {
             stack.push((0, t));
         }
         while let Some((i, entry)) = stack.pop() {
-            if best.is_some_and(|b| entry > b.t) {
+            if entry > limit {
                 continue;
             }
             let n = &self.nodes[i as usize];
             if n.is_leaf() {
                 for k in n.triangle_range() {
                     let tri = self.tris[k].map(|v| verts[v as usize]);
-                    if let Some(h) = ray_triangle(ray, &tri) {
+                    // The conservative f32 pre-test, then the exact test.
+                    let (e1, e2, ng, l1) = prepare_triangle(&tri.map(Vec3A::from));
+                    if !filter.may_hit(Vec3A::from(tri[0]), e1, e2, ng, l1, limit) {
+                        continue;
+                    }
+                    let w = woop.get_or_insert_with(|| WoopRay::new(ray));
+                    if let Some(h) = w.hit(&tri) {
                         let id = self.ids[k];
                         let better = match best {
                             None => true,
@@ -76,8 +95,9 @@ impl<BV: BoundingVolume> Bvh<BV> {
                                 v: h.v,
                             });
                             if any {
-                                return Ok(best);
+                                return best;
                             }
+                            limit = h.t;
                         }
                     }
                 }
@@ -102,6 +122,6 @@ impl<BV: BoundingVolume> Bvh<BV> {
                 (None, None) => {}
             }
         }
-        Ok(best)
+        best
     }
 }

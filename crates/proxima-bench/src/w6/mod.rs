@@ -1,0 +1,328 @@
+//! W6, rays vs one mesh (design §5): `proxima-bench w6 [--mesh NAME,NAME]
+//! [--rays R] [--threads 1,2] [--repeats N] [--leaf L] [--seed S] [--only A,B]
+//! [--clock cpu|wall] [--json]`.
+//!
+//! For each mesh of `shared/data` (or `--mesh`), R rays ([`rays::rays`]) go through
+//! every structure ([`structures::entries`]): build time, median time per ray over
+//! the repeats on one thread (thread CPU time by default), the same batch on a
+//! rayon pool of each `--threads` size (wall time: several threads), hits, and the
+//! ratio to obvhs. In the same run every answer is checked ([`check`]): Proxima's
+//! structures must agree exactly with each other and with brute force (on a subset,
+//! and on every ray a peer disagrees on); peers may differ on grazing rays (their
+//! `f32` Möller tests are not watertight), and those rays are counted.
+
+pub mod check;
+pub mod rays;
+pub mod structures;
+
+use crate::run::{median, Clock};
+use check::{Verdict, Verifier};
+use proxima::geom::Ray;
+use proxima::narrow::{BuildOptions, SplitRule, TriMesh};
+use std::fmt::Write;
+use std::process::ExitCode;
+use std::time::Duration;
+pub use structures::RayCaster;
+
+const USAGE: &str = "usage: proxima-bench w6 [--mesh NAME,NAME] [--rays R] [--threads 1,2] [--repeats N] [--leaf L] [--seed S] [--only A,B] [--clock cpu|wall] [--json]";
+
+/// The default meshes (`shared/data`).
+pub const MESHES: [&str; 5] = [
+    "bunny.obj",
+    "teapot.obj",
+    "env.obj",
+    "SKINbody.stl",
+    "BONERibcage.stl",
+];
+
+/// Rays brute force runs on (it costs a full mesh pass per ray).
+const BRUTE_RAYS: usize = 500;
+
+struct Args {
+    meshes: Vec<String>,
+    rays: usize,
+    threads: Vec<usize>,
+    repeats: usize,
+    leaf: usize,
+    seed: u64,
+    only: Vec<String>,
+    clock: Clock,
+    json: bool,
+}
+
+fn list(s: &str) -> Vec<String> {
+    s.split(',')
+        .filter(|s| !s.is_empty())
+        .map(String::from)
+        .collect()
+}
+
+fn num<T: std::str::FromStr>(s: &str) -> Result<T, String> {
+    s.replace('_', "")
+        .parse()
+        .map_err(|_| format!("not a number: {s:?}"))
+}
+
+fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
+    let mut a = Args {
+        meshes: MESHES.iter().map(|s| s.to_string()).collect(),
+        rays: 100_000,
+        threads: vec![1, 2],
+        repeats: 5,
+        leaf: 4,
+        seed: 1,
+        only: Vec::new(),
+        clock: Clock::ThreadCpu,
+        json: false,
+    };
+    while let Some(flag) = it.next() {
+        let mut value = |name: &str| it.next().ok_or(format!("{name} needs a value"));
+        match flag.as_str() {
+            "--mesh" => a.meshes = list(&value("--mesh")?),
+            "--rays" => a.rays = num(&value("--rays")?)?,
+            "--threads" => {
+                a.threads = list(&value("--threads")?)
+                    .iter()
+                    .map(|s| num(s))
+                    .collect::<Result<_, _>>()?
+            }
+            "--repeats" => a.repeats = num(&value("--repeats")?)?,
+            "--leaf" => a.leaf = num(&value("--leaf")?)?,
+            "--seed" => a.seed = num(&value("--seed")?)?,
+            "--only" => a.only = list(&value("--only")?),
+            "--clock" => {
+                a.clock = match value("--clock")?.as_str() {
+                    "cpu" => Clock::ThreadCpu,
+                    "wall" => Clock::Wall,
+                    o => return Err(format!("--clock takes cpu or wall, not {o:?}")),
+                }
+            }
+            "--json" => a.json = true,
+            "-h" | "--help" => return Err(String::new()),
+            o => return Err(format!("unknown argument {o:?}")),
+        }
+    }
+    if a.rays == 0 || a.repeats == 0 || a.leaf == 0 || a.threads.contains(&0) {
+        return Err("--rays, --repeats, --leaf and thread counts must be at least 1".into());
+    }
+    Ok(a)
+}
+
+/// What one structure measured on one mesh.
+pub struct Row {
+    /// Structure name.
+    pub name: &'static str,
+    /// Peer crate.
+    pub peer: bool,
+    /// Rays cast.
+    pub rays: usize,
+    /// Build time.
+    pub build: Duration,
+    /// Median time per ray, one thread.
+    pub per_ray: Duration,
+    /// Median wall time per ray of the parallel batch, per thread count.
+    pub par: Vec<(usize, Duration)>,
+    /// Rays that hit.
+    pub hits: usize,
+    /// The agreement check.
+    pub verdict: Verdict,
+}
+
+fn per_ray(d: Duration, n: usize) -> Duration {
+    d / n.max(1) as u32
+}
+
+fn run_mesh(a: &Args, mesh: &TriMesh, out: &mut Vec<Row>) -> Result<(), String> {
+    let rays = rays::rays(mesh, a.rays, a.seed);
+    let brute_n = BRUTE_RAYS.min(rays.len());
+    let opts = BuildOptions {
+        split: SplitRule::Sah,
+        leaf_size: a.leaf,
+    };
+    let mut verifier = Verifier::new(mesh, &rays);
+    for e in structures::entries() {
+        if !a.only.is_empty() && !a.only.iter().any(|o| o == e.name) {
+            continue;
+        }
+        eprintln!("  {} ...", e.name);
+        let (s, build) = a.clock.time(|| (e.make)(mesh, opts));
+        let set: &[Ray] = if e.subset { &rays[..brute_n] } else { &rays };
+        let repeats = if e.subset { 1 } else { a.repeats };
+        let mut times = Vec::with_capacity(repeats);
+        let mut res = Vec::new();
+        for _ in 0..repeats {
+            let (r, t) = a
+                .clock
+                .time(|| set.iter().map(|r| s.cast(r)).collect::<Vec<_>>());
+            times.push(t);
+            res = r;
+        }
+        let mut par = Vec::new();
+        if !e.subset {
+            for &k in &a.threads {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(k)
+                    .build()
+                    .map_err(|e| e.to_string())?;
+                let mut pt = Vec::with_capacity(repeats);
+                for _ in 0..repeats {
+                    let (r, t) = Clock::Wall.time(|| pool.install(|| s.cast_par(set)));
+                    if r != res {
+                        return Err(format!(
+                            "{}: parallel batch differs from sequential",
+                            e.name
+                        ));
+                    }
+                    pt.push(t);
+                }
+                par.push((k, per_ray(median(&pt), set.len())));
+            }
+        }
+        let verdict = verifier.check(e.name, e.peer, &res)?;
+        out.push(Row {
+            name: e.name,
+            peer: e.peer,
+            rays: set.len(),
+            build,
+            per_ray: per_ray(median(&times), set.len()),
+            par,
+            hits: res.iter().filter(|h| h.is_some()).count(),
+            verdict,
+        });
+    }
+    Ok(())
+}
+
+fn us(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e6
+}
+
+fn ratio(r: &Row, rows: &[Row]) -> Option<f64> {
+    let o = rows.iter().find(|x| x.name == structures::OBVHS)?;
+    (o.per_ray > Duration::ZERO).then(|| us(r.per_ray) / us(o.per_ray))
+}
+
+fn table(rows: &[Row], threads: &[usize]) -> String {
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        "{:<16} {:>9} {:>8} {:>9}",
+        "structure", "build ms", "rays", "us/ray"
+    );
+    for k in threads {
+        let _ = write!(s, " {:>9}", format!("par{k}T"));
+    }
+    let _ = writeln!(s, " {:>8} {:>9} {:>9}", "hits", "disagree", "vs obvhs");
+    for r in rows {
+        let _ = write!(
+            s,
+            "{:<16} {:>9.2} {:>8} {:>9.3}",
+            r.name,
+            r.build.as_secs_f64() * 1e3,
+            r.rays,
+            us(r.per_ray)
+        );
+        for k in threads {
+            match r.par.iter().find(|p| p.0 == *k) {
+                Some(p) => {
+                    let _ = write!(s, " {:>9.3}", us(p.1));
+                }
+                None => {
+                    let _ = write!(s, " {:>9}", "-");
+                }
+            }
+        }
+        let ratio = ratio(r, rows).map_or("-".into(), |x| format!("{x:.2}x"));
+        let _ = writeln!(s, " {:>8} {:>9} {:>9}", r.hits, r.verdict.disagree, ratio);
+    }
+    for r in rows.iter().filter(|r| r.verdict.disagree > 0) {
+        let _ = writeln!(s, "  {}: {}", r.name, r.verdict.explain());
+    }
+    s
+}
+
+fn json(mesh: &str, rows: &[Row], out: &mut String) {
+    for r in rows {
+        let par: Vec<String> = r
+            .par
+            .iter()
+            .map(|(k, d)| format!("\"{k}\": {:.4}", us(*d)))
+            .collect();
+        let _ = writeln!(
+            out,
+            "{{\"workload\": \"w6\", \"mesh\": \"{mesh}\", \"structure\": \"{}\", \"peer\": {}, \"rays\": {}, \"build_ms\": {:.4}, \"us_per_ray\": {:.4}, \"par_us_per_ray\": {{{}}}, \"hits\": {}, \"disagree\": {}, \"vs_obvhs\": {}}},",
+            r.name,
+            r.peer,
+            r.rays,
+            r.build.as_secs_f64() * 1e3,
+            us(r.per_ray),
+            par.join(", "),
+            r.hits,
+            r.verdict.disagree,
+            ratio(r, rows).map_or("null".into(), |x| format!("{x:.4}"))
+        );
+    }
+}
+
+fn data_dir() -> String {
+    concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/").to_string()
+}
+
+/// Runs W6 with the arguments after `w6`; the exit code is 1 on any disagreement
+/// that is not explained (ours vs brute force, or a peer beyond its tolerance).
+pub fn main(args: impl Iterator<Item = String>) -> ExitCode {
+    let a = match parse(args) {
+        Ok(a) => a,
+        Err(e) => {
+            if !e.is_empty() {
+                eprintln!("error: {e}");
+            }
+            eprintln!("{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    let mut js = String::from("[\n");
+    for name in &a.meshes {
+        let path = if name.contains('/') {
+            name.clone()
+        } else {
+            format!("{}{name}", data_dir())
+        };
+        let mesh = match proxima::io::load(&path) {
+            Ok(m) => m,
+            Err(e) => {
+                eprintln!("error: {path}: {e}");
+                return ExitCode::from(2);
+            }
+        };
+        eprintln!("{name} ({} triangles):", mesh.len());
+        let mut rows = Vec::new();
+        if let Err(e) = run_mesh(&a, &mesh, &mut rows) {
+            eprintln!("W6 CHECK FAILED on {name}: {e}");
+            return ExitCode::from(1);
+        }
+        if a.json {
+            json(name, &rows, &mut js);
+        } else {
+            println!(
+                "w6 {name} tris={} rays={} seed={} leaf={} clock={} (us/ray: median of {} on one thread; parKT: rayon batch on K threads, wall)",
+                mesh.len(),
+                a.rays,
+                a.seed,
+                a.leaf,
+                a.clock.name(),
+                a.repeats
+            );
+            print!("{}", table(&rows, &a.threads));
+        }
+    }
+    if a.json {
+        if js.ends_with(",\n") {
+            js.truncate(js.len() - 2);
+            js.push('\n');
+        }
+        js.push_str("]\n");
+        print!("{js}");
+    }
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,260 @@
+//! Ray casts on the shared meshes against brute force over every triangle with
+//! `ray_triangle`: random rays from outside and inside, rays aimed exactly at
+//! vertices and edge points, axis-parallel rays, rays in a triangle's plane,
+//! bounded rays; for [`RayBvh`] (every split rule and leaf size, and the k-DOP
+//! topology) and for `Bvh<BV>` with every volume.
+
+use super::meshes::{torus, uv_sphere};
+use proxima::geom::{Aabb, Ray, Segment, Sphere};
+use proxima::glam::Vec3;
+use proxima::narrow::{
+    ray_triangle, BoundingVolume, BuildOptions, Bvh, Kdop14, Kdop18, Kdop26, Obb, RayBvh,
+    SplitRule, TriMesh,
+};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+fn data(name: &str) -> TriMesh {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/");
+    proxima::io::load(format!("{dir}{name}")).unwrap()
+}
+
+/// The oracle: smallest `t`, ties to the smaller triangle index.
+fn brute(m: &TriMesh, ray: &Ray) -> Option<(u32, f32)> {
+    let mut best: Option<(u32, f32)> = None;
+    for i in 0..m.len() {
+        if let Some(h) = ray_triangle(ray, &m.triangle(i)) {
+            if best.map_or(true, |(_, t)| h.t < t) {
+                best = Some((i as u32, h.t));
+            }
+        }
+    }
+    best
+}
+
+fn bounds(m: &TriMesh) -> (Vec3, Vec3) {
+    m.vertices()
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        })
+}
+
+/// `n` rays of every family (see the module doc) around `m`.
+fn ray_mix(m: &TriMesh, n: usize, seed: u64) -> Vec<Ray> {
+    let (lo, hi) = bounds(m);
+    let (c, h) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+    let r = h.length();
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let mut out = Vec::with_capacity(n);
+    let unit = |rng: &mut Pcg64| loop {
+        let v = Vec3::new(
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+        );
+        if v.length_squared() > 1e-3 && v.length_squared() <= 1.0 {
+            return v.normalize();
+        }
+    };
+    let in_box = |rng: &mut Pcg64, s: f32| {
+        c + h
+            * s
+            * Vec3::new(
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+            )
+    };
+    for i in 0..n {
+        let outside = c + unit(&mut rng) * (2.0 * r);
+        let tri = m.triangle(rng.gen_range(0..m.len()));
+        let ray = match i % 9 {
+            // From outside at a random point of the box.
+            0 => Ray::new(outside, in_box(&mut rng, 1.0) - outside),
+            // From inside (often inside the mesh), any direction.
+            1 => Ray::new(in_box(&mut rng, 0.8), unit(&mut rng)),
+            // Exactly at a vertex.
+            2 => Ray::new(outside, tri[rng.gen_range(0..3)] - outside),
+            // At a point of an edge (rounded to f32: on or next to the edge).
+            3 => {
+                let k = rng.gen_range(0..3);
+                let p = tri[k].lerp(tri[(k + 1) % 3], rng.gen_range(0.0..1.0));
+                Ray::new(outside, p - outside)
+            }
+            // Axis-parallel, through a vertex's coordinates or a random point.
+            4 => {
+                let axis = rng.gen_range(0..3);
+                let mut d = Vec3::ZERO;
+                d[axis] = if rng.gen_bool(0.5) { 1.0 } else { -1.0 };
+                let mut o = if rng.gen_bool(0.5) {
+                    tri[0]
+                } else {
+                    in_box(&mut rng, 1.0)
+                };
+                o[axis] = c[axis] - d[axis] * 2.0 * r;
+                Ray::new(o, d)
+            }
+            // In a triangle's plane, along an edge, from a corner or from outside.
+            5 => {
+                let d = tri[1] - tri[0];
+                if d == Vec3::ZERO {
+                    Ray::new(outside, c - outside)
+                } else if rng.gen_bool(0.5) {
+                    Ray::new(tri[0], d)
+                } else {
+                    Ray::new(tri[0] - d * 3.0, d)
+                }
+            }
+            // Starting exactly on a vertex (t = 0 hits), any direction.
+            6 => Ray::new(tri[rng.gen_range(0..3)], unit(&mut rng)),
+            // Bounded: stops around the surface.
+            7 => {
+                let p = in_box(&mut rng, 1.0);
+                let d = p - outside;
+                Ray::with_max_t(outside, d, rng.gen_range(0.3..1.0))
+            }
+            // A segment ending exactly on a vertex (hit at t = 1 or earlier).
+            _ => Segment::new(outside, tri[rng.gen_range(0..3)]).to_ray(),
+        };
+        out.push(ray);
+    }
+    out
+}
+
+fn check_ray_bvh(m: &TriMesh, t: &RayBvh, rays: &[Ray], wants: &[Option<(u32, f32)>], what: &str) {
+    for (k, (ray, want)) in rays.iter().zip(wants).enumerate() {
+        let got = t.cast_ray(ray).unwrap();
+        assert_eq!(
+            got.map(|h| (h.triangle, h.t)),
+            *want,
+            "{what} ray {k} {ray:?}"
+        );
+        if let Some(h) = got {
+            let [p, q, r] = m.triangle(h.triangle as usize);
+            let on = p * (1.0 - h.u - h.v) + q * h.u + r * h.v;
+            let scale = 1.0 + ray.origin.abs().max_element() + (h.t * ray.dir).length();
+            assert!(
+                (on - ray.at(h.t)).length() <= 1e-4 * scale,
+                "{what} ray {k}"
+            );
+        }
+        assert_eq!(
+            t.ray_hits_any(ray).unwrap().is_some(),
+            want.is_some(),
+            "{what} any ray {k}"
+        );
+    }
+}
+
+fn check_bvh<BV: BoundingVolume>(m: &TriMesh, rays: &[Ray], wants: &[Option<(u32, f32)>]) {
+    let t = Bvh::<BV>::build(m, BuildOptions::default()).unwrap();
+    for (k, (ray, want)) in rays.iter().zip(wants).enumerate() {
+        let got = t.cast_ray(m, ray).unwrap().map(|h| (h.triangle, h.t));
+        assert_eq!(got, *want, "{} ray {k} {ray:?}", BV::NAME);
+    }
+}
+
+/// Every structure against brute force on `n` rays of the mix.
+fn check_mesh(m: &TriMesh, n: usize, seed: u64) {
+    let rays = ray_mix(m, n, seed);
+    let wants: Vec<_> = rays.iter().map(|r| brute(m, r)).collect();
+    let hits = wants.iter().filter(|w| w.is_some()).count();
+    assert!(hits * 5 > n && hits < n, "{hits} of {n} rays hit");
+    for split in [SplitRule::Sah, SplitRule::Median, SplitRule::Mean] {
+        for leaf in [1, 4, 8] {
+            let o = BuildOptions {
+                split,
+                leaf_size: leaf,
+            };
+            let t = RayBvh::build(m, o).unwrap();
+            check_ray_bvh(m, &t, &rays, &wants, &format!("RayBvh {o:?}"));
+        }
+    }
+    let k = Bvh::<Kdop18>::build(m, BuildOptions::default()).unwrap();
+    let t = RayBvh::from_bvh(&k, m).unwrap();
+    check_ray_bvh(m, &t, &rays, &wants, "RayBvh from k-DOP");
+    check_bvh::<Aabb>(m, &rays, &wants);
+    check_bvh::<Kdop14>(m, &rays, &wants);
+    check_bvh::<Kdop18>(m, &rays, &wants);
+    check_bvh::<Kdop26>(m, &rays, &wants);
+    check_bvh::<Obb>(m, &rays, &wants);
+    check_bvh::<Sphere>(m, &rays, &wants);
+}
+
+#[test]
+fn rays_bunny() {
+    check_mesh(&data("bunny.obj"), 1500, 1);
+}
+
+#[test]
+fn rays_teapot() {
+    check_mesh(&data("teapot.obj"), 1500, 2);
+}
+
+#[test]
+fn rays_env_and_rob() {
+    check_mesh(&data("env.obj"), 1000, 3);
+    check_mesh(&data("rob.obj"), 1000, 4);
+}
+
+#[test]
+fn rays_skin_body() {
+    check_mesh(&data("SKINbody.stl"), 250, 5);
+}
+
+#[test]
+fn rays_procedural() {
+    check_mesh(&torus(2.0, 0.6, 24, 12), 1500, 6);
+    check_mesh(&uv_sphere(Vec3::ZERO, 1.5, 12, 8), 1500, 7);
+}
+
+/// Deform, refit, and compare again.
+#[test]
+fn ray_bvh_refit_matches_brute_force() {
+    let mut m = data("bunny.obj");
+    let mut t = RayBvh::build(&m, BuildOptions::default()).unwrap();
+    for step in 0..3 {
+        let v: Vec<Vec3> = m
+            .vertices()
+            .iter()
+            .map(|&p| p * (1.0 + 0.1 * (p.y * 20.0 + step as f32).sin()))
+            .collect();
+        m.set_vertices(&v).unwrap();
+        t.refit(m.vertices()).unwrap();
+        let rays = ray_mix(&m, 300, 10 + step);
+        let wants: Vec<_> = rays.iter().map(|r| brute(&m, r)).collect();
+        check_ray_bvh(&m, &t, &rays, &wants, "refit");
+    }
+    assert!(t.refit(&m.vertices()[1..]).is_err());
+    let mut nan = m.vertices().to_vec();
+    nan[0].x = f32::NAN;
+    assert!(t.refit(&nan).is_err());
+    assert!(t.cast_ray(&Ray::new(Vec3::ZERO, Vec3::ZERO)).is_err());
+    assert!(t
+        .cast_ray(&Ray::with_max_t(Vec3::ZERO, Vec3::X, -1.0))
+        .is_err());
+}
+
+/// The batch helpers give exactly the sequential answers, and fail on a bad ray.
+#[cfg(feature = "parallel")]
+#[test]
+fn parallel_batches_equal_sequential_casts() {
+    let m = data("teapot.obj");
+    let rays = ray_mix(&m, 3000, 11);
+    let t = RayBvh::build(&m, BuildOptions::default()).unwrap();
+    let b = Bvh::<Kdop18>::build(&m, BuildOptions::default()).unwrap();
+    let seq: Vec<_> = rays.iter().map(|r| t.cast_ray(r).unwrap()).collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        assert_eq!(t.cast_rays_par(&rays).unwrap(), seq);
+        assert_eq!(b.cast_rays_par(&m, &rays).unwrap(), seq);
+    });
+    let mut bad = rays.clone();
+    bad[1234].dir = Vec3::ZERO;
+    assert!(t.cast_rays_par(&bad).is_err());
+    assert!(b.cast_rays_par(&m, &bad).is_err());
+}

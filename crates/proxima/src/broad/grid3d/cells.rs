@@ -8,7 +8,7 @@
 //! rounding of `(x - origin) / cell` is far below the 2 % of a cell kept free by
 //! [`GRID_FRACTION`].
 
-use crate::geom::{Aabb, Sphere};
+use crate::geom::Aabb;
 use crate::{Error, Result};
 use rustc_hash::FxHashMap;
 
@@ -21,7 +21,7 @@ pub const GRID_FRACTION: f32 = 0.49;
 /// of a cell near the grid).
 pub const MAX_CELLS_PER_AXIS: u32 = 1 << 12;
 
-/// Most cells in a grid (about 88 bytes each).
+/// Most cells in a grid (about 20 bytes each).
 pub const MAX_CELLS: u64 = 1 << 21;
 
 /// Spheres stored inline in a cell; more spill to a side table.
@@ -180,23 +180,17 @@ impl Geometry {
     }
 }
 
-/// The spheres of a cell beyond the inline ones.
-#[derive(Clone, Debug, Default)]
-pub struct Spill {
-    pub slots: Vec<u32>,
-    pub spheres: Vec<Sphere>,
-}
-
-/// Every cell's objects, structure-of-arrays: a dense count per cell (so empty
-/// neighbours cost one 4-byte read), then up to [`INLINE`] slots and spheres
-/// stored in the cell itself, and any further ones in a side table. Positions
-/// `0..count` name a cell's entries; removal swaps the last entry into the hole.
+/// Every cell's objects by slot: a dense count per cell (so an empty neighbour
+/// costs one 4-byte read), up to [`INLINE`] slots stored in the cell itself, and
+/// any further ones in a side table. Positions `0..count` name a cell's entries;
+/// removal swaps the last entry into the hole. The spheres themselves live in one
+/// array by slot, so an update that keeps its cell writes where the caller's
+/// updates already stream (see the pair search for how they are read back).
 #[derive(Clone, Debug)]
 pub struct CellStore {
     pub counts: Vec<u32>,
     pub slots: Vec<[u32; INLINE]>,
-    pub spheres: Vec<[Sphere; INLINE]>,
-    pub spill: FxHashMap<u32, Spill>,
+    pub spill: FxHashMap<u32, Vec<u32>>,
 }
 
 impl CellStore {
@@ -205,33 +199,19 @@ impl CellStore {
         CellStore {
             counts: vec![0; n],
             slots: vec![[0; INLINE]; n],
-            spheres: vec![[Sphere::new(glam::Vec3::ZERO, 0.0); INLINE]; n],
             spill: FxHashMap::default(),
         }
     }
 
-    /// The entries of cell `c`: the inline part and the spilled part.
+    /// The slots of cell `c`: the inline part and the spilled part.
     #[inline]
-    pub fn parts(&self, c: u32) -> [(&[u32], &[Sphere]); 2] {
+    pub fn parts(&self, c: u32) -> [&[u32]; 2] {
         let n = self.counts[c as usize] as usize;
-        let k = n.min(INLINE);
-        let inline = (&self.slots[c as usize][..k], &self.spheres[c as usize][..k]);
+        let inline = &self.slots[c as usize][..n.min(INLINE)];
         if n > INLINE {
-            let s = &self.spill[&c];
-            [inline, (&s.slots[..], &s.spheres[..])]
+            [inline, &self.spill[&c][..]]
         } else {
-            [inline, (&[], &[])]
-        }
-    }
-
-    /// The sphere at position `i` of cell `c`.
-    #[inline]
-    pub fn sphere(&self, c: u32, i: u32) -> &Sphere {
-        let i = i as usize;
-        if i < INLINE {
-            &self.spheres[c as usize][i]
-        } else {
-            &self.spill[&c].spheres[i - INLINE]
+            [inline, &[]]
         }
     }
 
@@ -242,33 +222,29 @@ impl CellStore {
         if i < INLINE {
             self.slots[c as usize][i]
         } else {
-            self.spill[&c].slots[i - INLINE]
+            self.spill[&c][i - INLINE]
         }
     }
 
-    /// Overwrites the sphere at position `i` of cell `c`. O(1).
+    /// Writes the slot at position `i` of cell `c`.
     #[inline]
-    pub fn set(&mut self, c: u32, i: u32, s: Sphere) {
+    fn set_slot(&mut self, c: u32, i: u32, slot: u32) {
         let i = i as usize;
         if i < INLINE {
-            self.spheres[c as usize][i] = s;
+            self.slots[c as usize][i] = slot;
         } else if let Some(sp) = self.spill.get_mut(&c) {
-            sp.spheres[i - INLINE] = s;
+            sp[i - INLINE] = slot;
         }
     }
 
-    /// Appends an entry to cell `c` and returns its position. O(1) amortized.
+    /// Appends `slot` to cell `c` and returns its position. O(1) amortized.
     #[inline]
-    pub fn push(&mut self, c: u32, slot: u32, s: Sphere) -> u32 {
+    pub fn push(&mut self, c: u32, slot: u32) -> u32 {
         let n = self.counts[c as usize];
-        let i = n as usize;
-        if i < INLINE {
-            self.slots[c as usize][i] = slot;
-            self.spheres[c as usize][i] = s;
+        if (n as usize) < INLINE {
+            self.slots[c as usize][n as usize] = slot;
         } else {
-            let sp = self.spill.entry(c).or_default();
-            sp.slots.push(slot);
-            sp.spheres.push(s);
+            self.spill.entry(c).or_default().push(slot);
         }
         self.counts[c as usize] = n + 1;
         n
@@ -280,20 +256,14 @@ impl CellStore {
     pub fn remove(&mut self, c: u32, i: u32) -> Option<u32> {
         let last = self.counts[c as usize] - 1;
         let moved = (i != last).then(|| {
-            let (slot, s) = (self.slot(c, last), *self.sphere(c, last));
-            self.set(c, i, s);
-            if (i as usize) < INLINE {
-                self.slots[c as usize][i as usize] = slot;
-            } else if let Some(sp) = self.spill.get_mut(&c) {
-                sp.slots[i as usize - INLINE] = slot;
-            }
+            let slot = self.slot(c, last);
+            self.set_slot(c, i, slot);
             slot
         });
         if last as usize >= INLINE {
             let sp = self.spill.get_mut(&c).expect("spilled cell without spill");
-            sp.slots.pop();
-            sp.spheres.pop();
-            if sp.slots.is_empty() {
+            sp.pop();
+            if sp.is_empty() {
                 self.spill.remove(&c);
             }
         }
@@ -303,14 +273,9 @@ impl CellStore {
 
     /// Heap bytes.
     pub fn heap_bytes(&self) -> usize {
-        let n = self.counts.capacity();
-        n * (4 + std::mem::size_of::<[u32; INLINE]>() + std::mem::size_of::<[Sphere; INLINE]>())
-            + self.spill.capacity() * (std::mem::size_of::<(u32, Spill)>() + 1)
-            + self
-                .spill
-                .values()
-                .map(|s| s.slots.capacity() * 4 + s.spheres.capacity() * 16)
-                .sum::<usize>()
+        self.counts.capacity() * (4 + std::mem::size_of::<[u32; INLINE]>())
+            + self.spill.capacity() * (std::mem::size_of::<(u32, Vec<u32>)>() + 1)
+            + self.spill.values().map(|s| s.capacity() * 4).sum::<usize>()
     }
 }
 
@@ -338,18 +303,17 @@ mod tests {
     #[test]
     fn store_spills_and_swaps() {
         let mut st = CellStore::new(2);
-        let s = |x: f32| Sphere::new(vec3(x, 0.0, 0.0), 1.0);
         for k in 0..7 {
-            assert_eq!(st.push(1, k, s(k as f32)), k);
+            assert_eq!(st.push(1, k), k);
         }
-        assert_eq!(st.parts(1)[1].0, &[4, 5, 6]);
+        assert_eq!(st.parts(1)[1], &[4, 5, 6]);
         // Removing an inline entry pulls the last spilled one in.
         assert_eq!(st.remove(1, 0), Some(6));
-        assert_eq!((st.slot(1, 0), st.sphere(1, 0).center.x), (6, 6.0));
+        assert_eq!(st.slot(1, 0), 6);
         assert_eq!(st.remove(1, 5), None);
         assert_eq!(st.remove(1, 4), None);
         assert!(st.spill.is_empty());
-        assert_eq!(st.parts(1)[0].0, &[6, 1, 2, 3]);
+        assert_eq!(st.parts(1)[0], &[6, 1, 2, 3]);
         assert_eq!(st.counts, vec![0, 4]);
     }
 }

@@ -48,8 +48,9 @@ impl<T> UniformGrid3d<T> {
                     continue;
                 }
             }
-            for (sl, sp) in self.store.parts(c) {
-                for (&slot, s) in sl.iter().zip(sp) {
+            for part in self.store.parts(c) {
+                for &slot in part {
+                    let s = &self.spheres[slot as usize];
                     if rel == Relation::Inside || q.selects(s) {
                         let (h, v) = self.resolve(slot);
                         f(h, s, v)?;

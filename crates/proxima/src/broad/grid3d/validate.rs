@@ -23,6 +23,9 @@ impl<T> UniformGrid3d<T> {
         }
         for (h, _) in self.items.iter() {
             let slot = h.index();
+            if self.spheres.len() <= slot as usize {
+                return fail(format!("no sphere for slot {slot}"));
+            }
             let Some(&loc) = self.locs.get(slot as usize) else {
                 return fail(format!("no location for slot {slot}"));
             };
@@ -31,7 +34,7 @@ impl<T> UniformGrid3d<T> {
                 if self.large.get(idx as usize) != Some(&slot) {
                     return fail(format!("large entry {idx} is not slot {slot}"));
                 }
-                if self.large_spheres[idx as usize].radius <= self.geom.limit {
+                if self.spheres[slot as usize].radius <= self.geom.limit {
                     return fail(format!("slot {slot} is large but small enough to grid"));
                 }
                 continue;
@@ -42,7 +45,7 @@ impl<T> UniformGrid3d<T> {
             if self.store.slot(cell, idx) != slot {
                 return fail(format!("entry {loc:?} is not slot {slot}"));
             }
-            let s = self.store.sphere(cell, idx);
+            let s = &self.spheres[slot as usize];
             if self.geom.cell_of(s.center) != cell {
                 return fail(format!("slot {slot} is not in the cell of its centre"));
             }
@@ -54,9 +57,7 @@ impl<T> UniformGrid3d<T> {
             }
         }
         let gridded: usize = self.store.counts.iter().map(|&c| c as usize).sum();
-        if gridded + self.large.len() != self.items.len()
-            || self.large.len() != self.large_spheres.len()
-        {
+        if gridded + self.large.len() != self.items.len() {
             return fail(format!(
                 "{gridded} gridded + {} large objects, {} stored",
                 self.large.len(),
@@ -65,10 +66,7 @@ impl<T> UniformGrid3d<T> {
         }
         for (&c, sp) in &self.store.spill {
             let count = self.store.counts.get(c as usize).copied().unwrap_or(0) as usize;
-            if sp.slots.is_empty()
-                || sp.slots.len() != sp.spheres.len()
-                || count != INLINE + sp.slots.len()
-            {
+            if sp.is_empty() || count != INLINE + sp.len() {
                 return fail(format!("spill of cell {c} does not match its count"));
             }
         }

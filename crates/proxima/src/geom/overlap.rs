@@ -4,7 +4,7 @@
 //! Closed means boundaries count: touching shapes overlap. Costs are O(1).
 
 use crate::geom::{Aabb, Frustum, Ray, Relation, Sphere};
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 // The sphere tests are exact: whether `|p - q| <= r1 + r2` is decided for the
 // real numbers the `f32` inputs denote, at every magnitude. A fast `f64`
@@ -60,32 +60,24 @@ pub fn sphere_sphere(a: &Sphere, b: &Sphere) -> bool {
 }
 
 /// Four sphere–sphere prefilters at once, for pair searches over lanes of
-/// spheres (`xs[i], ys[i], zs[i]` centre and `rs[i]` radius of lane `i`): bit `i`
-/// of the result is clear only if `a` and lane `i` certainly do not overlap, so
-/// a search may skip cleared lanes and must decide set ones with
-/// [`sphere_sphere`]. Branch-free so that it vectorizes; O(1).
+/// spheres (lane `i` has centre `(xs[i], ys[i], zs[i])` and radius `rs[i]`):
+/// bit `i` of the result is clear only if `a` and lane `i` certainly do not
+/// overlap, so a search may skip cleared lanes and must decide set ones with
+/// [`sphere_sphere`]. SIMD on `glam`'s `Vec4` (SSE2); O(1).
 ///
 /// It rejects only gaps wider than 1e-4 of `|d|² + (r1 + r2)²`, 250× the
 /// relative error of the `f32` evaluation, so no overlapping pair is rejected;
-/// NaN and overflow (∞ ≤ ∞) keep the lane.
+/// NaN and overflow (∞ > ∞ is false) keep the lane.
 #[inline]
-pub fn sphere_sphere_maybe4(
-    a: &Sphere,
-    xs: &[f32; 4],
-    ys: &[f32; 4],
-    zs: &[f32; 4],
-    rs: &[f32; 4],
-) -> u32 {
-    let mut bits = 0;
-    for i in 0..4 {
-        let (dx, dy, dz) = (a.center.x - xs[i], a.center.y - ys[i], a.center.z - zs[i]);
-        let d2 = dx * dx + dy * dy + dz * dz;
-        let r = a.radius + rs[i];
-        let r2 = r * r;
-        let keep = !(d2 > r2 + (1e-4 * (d2 + r2) + 1e-30));
-        bits |= (keep as u32) << i;
-    }
-    bits
+pub fn sphere_sphere_maybe4(a: &Sphere, xs: Vec4, ys: Vec4, zs: Vec4, rs: Vec4) -> u32 {
+    let dx = Vec4::splat(a.center.x) - xs;
+    let dy = Vec4::splat(a.center.y) - ys;
+    let dz = Vec4::splat(a.center.z) - zs;
+    let d2 = dx * dx + dy * dy + dz * dz;
+    let r = Vec4::splat(a.radius) + rs;
+    let r2 = r * r;
+    let bound = r2 + (Vec4::splat(1e-4) * (d2 + r2) + Vec4::splat(1e-30));
+    (!d2.cmpgt(bound)).bitmask()
 }
 
 /// Sphere–AABB: the distance from the centre to the box (its closest point) is at
@@ -303,13 +295,13 @@ mod tests {
             let lanes: Vec<Sphere> = (0..4)
                 .map(|_| Sphere::new(vec3(v(), v(), v()), v().abs()))
                 .collect();
-            let col = |f: fn(&Sphere) -> f32| [0, 1, 2, 3].map(|i| f(&lanes[i]));
+            let col = |f: fn(&Sphere) -> f32| Vec4::from_array([0, 1, 2, 3].map(|i| f(&lanes[i])));
             let bits = sphere_sphere_maybe4(
                 &a,
-                &col(|s| s.center.x),
-                &col(|s| s.center.y),
-                &col(|s| s.center.z),
-                &col(|s| s.radius),
+                col(|s| s.center.x),
+                col(|s| s.center.y),
+                col(|s| s.center.z),
+                col(|s| s.radius),
             );
             for (i, l) in lanes.iter().enumerate() {
                 if bits & (1 << i) == 0 {
@@ -321,7 +313,13 @@ mod tests {
         assert!(cleared > 20_000, "{cleared}");
         // Touching spheres on a coarse grid (exact ties) are kept.
         let a = Sphere::new(Vec3::ZERO, 1.0);
-        let bits = sphere_sphere_maybe4(&a, &[2.0, 0.0, 3.0, 1.0], &[0.0; 4], &[0.0; 4], &[1.0; 4]);
+        let bits = sphere_sphere_maybe4(
+            &a,
+            Vec4::new(2.0, 0.0, 3.0, 1.0),
+            Vec4::ZERO,
+            Vec4::ZERO,
+            Vec4::ONE,
+        );
         assert_eq!(bits, 0b1011);
     }
 

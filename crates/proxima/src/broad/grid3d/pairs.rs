@@ -5,6 +5,7 @@ use super::cells::INLINE;
 use super::UniformGrid3d;
 use crate::arena::Handle;
 use crate::geom::{overlap, Sphere};
+use glam::Vec4;
 use std::ops::ControlFlow;
 
 /// The forward half of the 26 neighbours: `(dx, dy, dz)` greater than zero in
@@ -81,23 +82,29 @@ impl Batch {
 /// Cells gathered at a time beyond the look-ahead.
 const GATHER_AHEAD: u32 = 256;
 
-/// A cell's gathered spheres, structure of arrays: rows x, y, z, radius, one
-/// lane per entry (lanes past the cell's count are stale).
-type Lanes = [[f32; INLINE]; 4];
+/// A cell's gathered spheres as four SIMD rows: x, y, z, radius, one lane per
+/// entry (lanes past the cell's count are stale and masked off).
+type Lanes = [Vec4; 4];
+
+/// Lane masks by count: the first `min(count, 4)` lanes.
+const LANE_MASK: [u32; INLINE + 1] = [0, 0b1, 0b11, 0b111, 0b1111];
 
 /// The spheres of the cells just ahead of the pair scan, copied into cell order.
 ///
 /// Every forward neighbour of cell `c` lies in `c ..= c + look` (`look = nx·ny +
-/// nx + 1`), so a ring of the next `look + 1` cells (rounded up to a power of
-/// two) holds every sphere the scan compares at `c`. Each cell's spheres are
-/// gathered once, by independent reads of the slot-ordered array that the
-/// processor overlaps; the tests then read the ring contiguously. The ring is 64
-/// bytes per cell of an xy layer: a few hundred KB for W1 at 100k (L2-resident).
+/// nx + 1`), so a ring of the next `look + 1` cells (plus a gathering step,
+/// rounded up to a power of two) holds every sphere the scan compares at `c`.
+/// Each cell's spheres are gathered once, in batches of independent reads of
+/// the slot-ordered array (so the processor overlaps the cache misses); the
+/// tests then read the ring. The ring is 64 bytes per cell of an xy layer: a
+/// few hundred KB for W1 at 100k, so it stays in the L2 cache.
 struct Window {
     mask: usize,
     look: u32,
     next: u32,
     lanes: Vec<Lanes>,
+    /// (slot, cell · INLINE + lane) of the spheres to gather next.
+    todo: Vec<(u32, u32)>,
 }
 
 impl Window {
@@ -110,32 +117,39 @@ impl Window {
             mask: size - 1,
             look,
             next: c0,
-            lanes: vec![[[0.0; INLINE]; 4]; size],
+            lanes: vec![[Vec4::ZERO; 4]; size],
+            todo: Vec::with_capacity(GATHER_AHEAD as usize * INLINE),
         }
     }
 
     /// Makes sure the cells up to `c + look` are gathered, gathering
-    /// [`GATHER_AHEAD`] more at a time: a tight loop of independent loads keeps
-    /// many cache misses in flight, where one gather between tests keeps few.
+    /// [`GATHER_AHEAD`] more at a time.
     #[inline]
     fn advance<T>(&mut self, g: &UniformGrid3d<T>, c: u32) {
         if self.next > c + self.look {
             return;
         }
         let end = (c + self.look + GATHER_AHEAD).min(g.geom.cell_count() as u32 - 1);
-        while self.next <= end {
-            let k = self.next as usize;
-            let n = (g.store.counts[k] as usize).min(INLINE);
-            let dst = &mut self.lanes[k & self.mask];
-            for (i, &slot) in g.store.slots[k][..n].iter().enumerate() {
-                let s = &g.spheres[slot as usize];
-                dst[0][i] = s.center.x;
-                dst[1][i] = s.center.y;
-                dst[2][i] = s.center.z;
-                dst[3][i] = s.radius;
+        // First the (slot, lane) list, then the loads: a branch-free loop of
+        // independent loads.
+        self.todo.clear();
+        for k in self.next..=end {
+            let n = (g.store.counts[k as usize] as usize).min(INLINE);
+            let base = (k as usize & self.mask) * INLINE;
+            for (i, &slot) in g.store.slots[k as usize][..n].iter().enumerate() {
+                self.todo.push((slot, (base + i) as u32));
             }
-            self.next += 1;
         }
+        for &(slot, at) in &self.todo {
+            let s = &g.spheres[slot as usize];
+            let (cell, i) = (at as usize / INLINE, at as usize % INLINE);
+            let dst = &mut self.lanes[cell];
+            dst[0][i] = s.center.x;
+            dst[1][i] = s.center.y;
+            dst[2][i] = s.center.z;
+            dst[3][i] = s.radius;
+        }
+        self.next = end + 1;
     }
 
     /// The gathered lanes of cell `c`.
@@ -151,96 +165,6 @@ fn lane(l: &Lanes, i: usize) -> Sphere {
     Sphere::new(glam::vec3(l[0][i], l[1][i], l[2][i]), l[3][i])
 }
 
-/// The spheres of a cell's forward neighbours, appended lane-wise
-/// (structure of arrays) so that one object is tested against all of them four
-/// at a time. Always `len + 8` lanes long, so a 4-lane read from any lane below
-/// `len` stays in bounds (the lanes past `len` are stale and masked off).
-struct Candidates {
-    lanes: [Vec<f32>; 4],
-    slots: Vec<u32>,
-    len: usize,
-}
-
-impl Candidates {
-    fn new() -> Candidates {
-        let n = 13 * INLINE + 8;
-        Candidates {
-            lanes: [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]],
-            slots: vec![0; n],
-            len: 0,
-        }
-    }
-
-    #[inline]
-    fn reserve(&mut self, extra: usize) {
-        let want = self.len + extra + 8;
-        if want > self.slots.len() {
-            for l in &mut self.lanes {
-                l.resize(want, 0.0);
-            }
-            self.slots.resize(want, 0);
-        }
-    }
-
-    /// Appends the first `n` of a cell's inline lanes (copying all four keeps
-    /// it branch-free).
-    #[inline]
-    fn push_lanes(&mut self, l: &Lanes, slots: &[u32; INLINE], n: usize) {
-        let at = self.len;
-        for (dst, src) in self.lanes.iter_mut().zip(l) {
-            dst[at..at + INLINE].copy_from_slice(src);
-        }
-        self.slots[at..at + INLINE].copy_from_slice(slots);
-        self.len += n;
-    }
-
-    /// Appends one sphere.
-    fn push(&mut self, slot: u32, s: &Sphere) {
-        self.reserve(1);
-        let at = self.len;
-        for (a, v) in [s.center.x, s.center.y, s.center.z, s.radius].into_iter().enumerate() {
-            self.lanes[a][at] = v;
-        }
-        self.slots[at] = slot;
-        self.len += 1;
-    }
-
-    /// Reports every candidate overlapping `a` (slot `sa`).
-    #[inline]
-    fn test<T>(
-        &self,
-        g: &UniformGrid3d<T>,
-        sa: u32,
-        a: &Sphere,
-        batch: &mut Batch,
-        f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
-    ) -> ControlFlow<()> {
-        let [xs, ys, zs, rs] = &self.lanes;
-        let mut i = 0;
-        while i < self.len {
-            let four = |v: &Vec<f32>| -> [f32; 4] { v[i..i + 4].try_into().expect("4 lanes") };
-            let valid = if self.len - i >= 4 {
-                0b1111
-            } else {
-                (1u32 << (self.len - i)) - 1
-            };
-            let mut bits =
-                overlap::sphere_sphere_maybe4(a, &four(xs), &four(ys), &four(zs), &four(rs))
-                    & valid;
-            while bits != 0 {
-                let j = i + bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let b = Sphere::new(glam::vec3(xs[j], ys[j], zs[j]), rs[j]);
-                if overlap::sphere_sphere(a, &b) {
-                    batch.push(g, sa, self.slots[j], f)?;
-                }
-            }
-            i += 4;
-        }
-        ControlFlow::Continue(())
-    }
-}
-
 impl<T> UniformGrid3d<T> {
     /// Calls `f` once per overlapping pair of gridded objects whose first object
     /// (in the half-shell order) lies in a cell of `[c0, c1)`.
@@ -249,9 +173,8 @@ impl<T> UniformGrid3d<T> {
     /// than a cell apart and lie in the same or adjacent cells (clamping keeps
     /// that true for centres outside the world). Each cell is tested against
     /// itself (pairs `i < j`) and its forward neighbours, so every pair of cells
-    /// — and every pair of objects — is met exactly once. The neighbours'
-    /// spheres are collected lane-wise and each object of the cell is tested
-    /// against them four at a time with a branch-free prefilter
+    /// — and every pair of objects — is met exactly once. Each object is tested
+    /// against a whole neighbour cell at once with a SIMD prefilter
     /// ([`overlap::sphere_sphere_maybe4`]); what it keeps is decided by
     /// [`overlap::sphere_sphere`]. Cost O(cells in range + look-ahead + Σ k·k'),
     /// streaming through the cell arrays in memory order.
@@ -268,60 +191,56 @@ impl<T> UniformGrid3d<T> {
         let counts = &self.store.counts;
         let offsets = HALF_SHELL.map(|d| d[0] + nx as i32 * (d[1] + ny as i32 * d[2]));
         let mut win = Window::new(self, c0);
-        let mut cand = Candidates::new();
         let mut batch = Batch::new();
         let mut own: Vec<(u32, Sphere)> = Vec::new();
+        let mut nbrs = [0u32; 13];
         let [mut x, mut y, mut z] = self.geom.coords(c0);
         for c in c0..c1 {
             let n = counts[c as usize] as usize;
             if n != 0 {
                 win.advance(self, c);
-                // This cell's objects.
-                own.clear();
+                // The non-empty forward neighbours inside the grid, compacted
+                // without branches (a third of the cells are empty in W1, at
+                // random: branching on it would mispredict).
+                let mut k = 0;
+                let interior = x >= 1 && x + 1 < nx && y >= 1 && y + 1 < ny && z + 1 < nz;
+                for (d, off) in HALF_SHELL.iter().zip(offsets) {
+                    let inside = interior || {
+                        let (qx, qy, qz) = (x as i32 + d[0], y as i32 + d[1], z as i32 + d[2]);
+                        qx >= 0 && qx < nx as i32 && qy >= 0 && qy < ny as i32 && qz < nz as i32
+                    };
+                    let q = if inside { (c as i32 + off) as u32 } else { c };
+                    nbrs[k] = q;
+                    k += (inside && counts[q as usize] != 0) as usize;
+                }
                 let l = win.cell(c);
                 let slots = &self.store.slots[c as usize];
-                for i in 0..n.min(INLINE) {
-                    own.push((slots[i], lane(l, i)));
-                }
-                if n > INLINE {
+                if n <= INLINE {
+                    for i in 0..n {
+                        let a = lane(l, i);
+                        // Later lanes of this cell, then the neighbours.
+                        let later = LANE_MASK[n] & !LANE_MASK[i + 1];
+                        let bits = overlap::sphere_sphere_maybe4(&a, l[0], l[1], l[2], l[3]) & later;
+                        self.report_lanes(slots[i], &a, bits, l, slots, &mut batch, f)?;
+                        self.against(slots[i], &a, &nbrs[..k], &win, &mut batch, f)?;
+                    }
+                } else {
+                    // A spilled cell (rare in even scenes): all of its entries.
+                    own.clear();
+                    for i in 0..INLINE {
+                        own.push((slots[i], lane(l, i)));
+                    }
                     for &s in self.store.parts(c)[1] {
                         own.push((s, self.spheres[s as usize]));
                     }
-                }
-                for i in 0..n {
-                    for j in i + 1..n {
-                        if overlap::sphere_sphere(&own[i].1, &own[j].1) {
-                            batch.push(self, own[i].0, own[j].0, f)?;
+                    for i in 0..n {
+                        for j in i + 1..n {
+                            if overlap::sphere_sphere(&own[i].1, &own[j].1) {
+                                batch.push(self, own[i].0, own[j].0, f)?;
+                            }
                         }
+                        self.against(own[i].0, &own[i].1, &nbrs[..k], &win, &mut batch, f)?;
                     }
-                }
-                // The forward neighbours' objects.
-                cand.len = 0;
-                let interior = x >= 1 && x + 1 < nx && y + 1 < ny && y >= 1 && z + 1 < nz;
-                for (d, off) in HALF_SHELL.iter().zip(offsets) {
-                    if !interior {
-                        let (qx, qy, qz) = (x as i32 + d[0], y as i32 + d[1], z as i32 + d[2]);
-                        if qx < 0
-                            || qx >= nx as i32
-                            || qy < 0
-                            || qy >= ny as i32
-                            || qz >= nz as i32
-                        {
-                            continue;
-                        }
-                    }
-                    let q = (c as i32 + off) as u32;
-                    let m = counts[q as usize] as usize;
-                    cand.reserve(INLINE);
-                    cand.push_lanes(win.cell(q), &self.store.slots[q as usize], m.min(INLINE));
-                    if m > INLINE {
-                        for &s in self.store.parts(q)[1] {
-                            cand.push(s, &self.spheres[s as usize]);
-                        }
-                    }
-                }
-                for (sa, a) in &own {
-                    cand.test(self, *sa, a, &mut batch, f)?;
                 }
             }
             x += 1;
@@ -335,6 +254,60 @@ impl<T> UniformGrid3d<T> {
             }
         }
         batch.flush(self, f)
+    }
+
+    /// Tests object `sa` (sphere `a`) against every entry of the cells `nbrs`.
+    #[inline(always)]
+    fn against(
+        &self,
+        sa: u32,
+        a: &Sphere,
+        nbrs: &[u32],
+        win: &Window,
+        batch: &mut Batch,
+        f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        for &q in nbrs {
+            let m = self.store.counts[q as usize] as usize;
+            let l = win.cell(q);
+            let bits = overlap::sphere_sphere_maybe4(a, l[0], l[1], l[2], l[3])
+                & LANE_MASK[m.min(INLINE)];
+            if bits != 0 {
+                self.report_lanes(sa, a, bits, l, &self.store.slots[q as usize], batch, f)?;
+            }
+            if m > INLINE {
+                for &s in self.store.parts(q)[1] {
+                    if overlap::sphere_sphere(a, &self.spheres[s as usize]) {
+                        batch.push(self, sa, s, f)?;
+                    }
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Decides the lanes `bits` kept by the prefilter exactly and reports the
+    /// overlapping ones.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn report_lanes(
+        &self,
+        sa: u32,
+        a: &Sphere,
+        mut bits: u32,
+        l: &Lanes,
+        slots: &[u32; INLINE],
+        batch: &mut Batch,
+        f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        while bits != 0 {
+            let j = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if overlap::sphere_sphere(a, &lane(l, j)) {
+                batch.push(self, sa, slots[j], f)?;
+            }
+        }
+        ControlFlow::Continue(())
     }
 
     /// Pairs of large object `i`: with the large objects after it, then with every

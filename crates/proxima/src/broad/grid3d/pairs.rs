@@ -193,7 +193,7 @@ impl<T> UniformGrid3d<T> {
         let mut win = Window::new(self, c0);
         let mut batch = Batch::new();
         let mut own: Vec<(u32, Sphere)> = Vec::new();
-        let mut nbrs = [0u32; 13];
+        let mut nbrs = [(0u32, 0u32); 13];
         let [mut x, mut y, mut z] = self.geom.coords(c0);
         for c in c0..c1 {
             let n = counts[c as usize] as usize;
@@ -203,15 +203,26 @@ impl<T> UniformGrid3d<T> {
                 // without branches (a third of the cells are empty in W1, at
                 // random: branching on it would mispredict).
                 let mut k = 0;
-                let interior = x >= 1 && x + 1 < nx && y >= 1 && y + 1 < ny && z + 1 < nz;
-                for (d, off) in HALF_SHELL.iter().zip(offsets) {
-                    let inside = interior || {
+                if x >= 1 && x + 1 < nx && y >= 1 && y + 1 < ny && z + 1 < nz {
+                    for off in offsets {
+                        let q = (c as i32 + off) as u32;
+                        let m = counts[q as usize];
+                        nbrs[k] = (q, m);
+                        k += (m != 0) as usize;
+                    }
+                } else {
+                    for (d, off) in HALF_SHELL.iter().zip(offsets) {
                         let (qx, qy, qz) = (x as i32 + d[0], y as i32 + d[1], z as i32 + d[2]);
-                        qx >= 0 && qx < nx as i32 && qy >= 0 && qy < ny as i32 && qz < nz as i32
-                    };
-                    let q = if inside { (c as i32 + off) as u32 } else { c };
-                    nbrs[k] = q;
-                    k += (inside && counts[q as usize] != 0) as usize;
+                        let inside = qx >= 0
+                            && qx < nx as i32
+                            && qy >= 0
+                            && qy < ny as i32
+                            && qz < nz as i32;
+                        let q = if inside { (c as i32 + off) as u32 } else { c };
+                        let m = counts[q as usize];
+                        nbrs[k] = (q, m);
+                        k += (inside && m != 0) as usize;
+                    }
                 }
                 let l = win.cell(c);
                 let slots = &self.store.slots[c as usize];
@@ -262,13 +273,13 @@ impl<T> UniformGrid3d<T> {
         &self,
         sa: u32,
         a: &Sphere,
-        nbrs: &[u32],
+        nbrs: &[(u32, u32)],
         win: &Window,
         batch: &mut Batch,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        for &q in nbrs {
-            let m = self.store.counts[q as usize] as usize;
+        for &(q, m) in nbrs {
+            let m = m as usize;
             let l = win.cell(q);
             let bits = overlap::sphere_sphere_maybe4(a, l[0], l[1], l[2], l[3])
                 & LANE_MASK[m.min(INLINE)];

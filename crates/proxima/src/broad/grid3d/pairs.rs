@@ -231,16 +231,15 @@ impl<T> UniformGrid3d<T> {
                         let a = lane(l, i);
                         // Later lanes of this cell, then the neighbours.
                         let later = LANE_MASK[n] & !LANE_MASK[i + 1];
-                        let bits = overlap::sphere_sphere_maybe4(&a, l[0], l[1], l[2], l[3]) & later;
+                        let bits =
+                            overlap::sphere_sphere_maybe4(&a, l[0], l[1], l[2], l[3]) & later;
                         self.report_lanes(slots[i], &a, bits, l, slots, &mut batch, f)?;
                         self.against(slots[i], &a, &nbrs[..k], &win, &mut batch, f)?;
                     }
                 } else {
                     // A spilled cell (rare in even scenes): all of its entries.
                     own.clear();
-                    for i in 0..INLINE {
-                        own.push((slots[i], lane(l, i)));
-                    }
+                    own.extend(slots.iter().enumerate().map(|(i, &s)| (s, lane(l, i))));
                     for &s in self.store.parts(c)[1] {
                         own.push((s, self.spheres[s as usize]));
                     }
@@ -281,8 +280,8 @@ impl<T> UniformGrid3d<T> {
         for &(q, m) in nbrs {
             let m = m as usize;
             let l = win.cell(q);
-            let bits = overlap::sphere_sphere_maybe4(a, l[0], l[1], l[2], l[3])
-                & LANE_MASK[m.min(INLINE)];
+            let bits =
+                overlap::sphere_sphere_maybe4(a, l[0], l[1], l[2], l[3]) & LANE_MASK[m.min(INLINE)];
             if bits != 0 {
                 self.report_lanes(sa, a, bits, l, &self.store.slots[q as usize], batch, f)?;
             }

@@ -1,14 +1,19 @@
 //! [`ParallelPairs`] for the dense grid: runs of cells split across rayon's
-//! threads, then the large objects one task each.
+//! threads (a few runs per thread, each at least a few xy layers so that the
+//! scan's look-ahead stays small beside the run), then the large objects one
+//! task each.
 
 use super::UniformGrid3d;
 use crate::broad::ParallelPairs;
 use rayon::prelude::*;
 use std::ops::ControlFlow;
 
-/// Cells per task: enough work per task to amortize rayon's scheduling, enough
-/// tasks to balance two or more threads.
-const CELLS_PER_TASK: u32 = 4096;
+/// Tasks per thread: enough to balance uneven cells across threads.
+const TASKS_PER_THREAD: u32 = 4;
+
+/// Each task also gathers the spheres of one xy layer of cells beyond its run
+/// (the look-ahead of the pair scan), so a run is at least this many layers.
+const MIN_LAYERS_PER_TASK: u32 = 4;
 
 impl<T: Send + Sync> ParallelPairs<T> for UniformGrid3d<T> {
     /// Each task runs the sequential half-shell search over its own run of cells
@@ -23,12 +28,18 @@ impl<T: Send + Sync> ParallelPairs<T> for UniformGrid3d<T> {
         R: Fn(A, A) -> A + Sync + Send,
     {
         let cells = self.geom.cell_count() as u32;
-        let tasks = cells.div_ceil(CELLS_PER_TASK);
+        let [nx, ny, _] = self.geom.dims;
+        let threads = rayon::current_num_threads() as u32;
+        let per_task = cells
+            .div_ceil(TASKS_PER_THREAD * threads)
+            .max(MIN_LAYERS_PER_TASK * nx * ny)
+            .max(1);
+        let tasks = cells.div_ceil(per_task);
         let gridded = (0..tasks)
             .into_par_iter()
             .fold(&init, |acc, t| {
-                let c0 = t * CELLS_PER_TASK;
-                let c1 = (c0 + CELLS_PER_TASK).min(cells);
+                let c0 = t * per_task;
+                let c1 = (c0 + per_task).min(cells);
                 let mut acc = Some(acc);
                 let _ = self.visit_pairs(c0, c1, &mut |ha, va, hb, vb| {
                     acc = acc.take().map(|a| fold(a, ha, va, hb, vb));

@@ -84,7 +84,7 @@ const GATHER_AHEAD: u32 = 256;
 
 /// A cell's gathered spheres as four SIMD rows: x, y, z, radius, one lane per
 /// entry (lanes past the cell's count are stale and masked off).
-type Lanes = [Vec4; 4];
+type Lanes = [[f32; INLINE]; 4];
 
 /// Lane masks by count: the first `min(count, 4)` lanes.
 const LANE_MASK: [u32; INLINE + 1] = [0, 0b1, 0b11, 0b111, 0b1111];
@@ -117,7 +117,7 @@ impl Window {
             mask: size - 1,
             look,
             next: c0,
-            lanes: vec![[Vec4::ZERO; 4]; size],
+            lanes: vec![[[0.0; INLINE]; 4]; size],
             todo: Vec::with_capacity(GATHER_AHEAD as usize * INLINE),
         }
     }
@@ -157,6 +157,14 @@ impl Window {
     fn cell(&self, c: u32) -> &Lanes {
         &self.lanes[c as usize & self.mask]
     }
+}
+
+/// The prefilter of `a` against a cell's four lanes (plain arrays, so that the
+/// gather stores by lane without a dynamic `Vec4` index).
+#[inline(always)]
+fn maybe4(a: &Sphere, l: &Lanes) -> u32 {
+    let [x, y, z, r] = l.map(Vec4::from_array);
+    overlap::sphere_sphere_maybe4(a, x, y, z, r)
 }
 
 /// Sphere of lane `i`.
@@ -231,8 +239,7 @@ impl<T> UniformGrid3d<T> {
                         let a = lane(l, i);
                         // Later lanes of this cell, then the neighbours.
                         let later = LANE_MASK[n] & !LANE_MASK[i + 1];
-                        let bits =
-                            overlap::sphere_sphere_maybe4(&a, l[0], l[1], l[2], l[3]) & later;
+                        let bits = maybe4(&a, l) & later;
                         self.report_lanes(slots[i], &a, bits, l, slots, &mut batch, f)?;
                         self.against(slots[i], &a, &nbrs[..k], &win, &mut batch, f)?;
                     }
@@ -280,8 +287,7 @@ impl<T> UniformGrid3d<T> {
         for &(q, m) in nbrs {
             let m = m as usize;
             let l = win.cell(q);
-            let bits =
-                overlap::sphere_sphere_maybe4(a, l[0], l[1], l[2], l[3]) & LANE_MASK[m.min(INLINE)];
+            let bits = maybe4(a, l) & LANE_MASK[m.min(INLINE)];
             if bits != 0 {
                 self.report_lanes(sa, a, bits, l, &self.store.slots[q as usize], batch, f)?;
             }

@@ -6,6 +6,7 @@ use crate::structure::{Indexed, IndexedPar, Structure};
 use crate::workloads::Scene;
 use proxima::broad::{
     loose_kd, BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, UniformGrid2d,
+    UniformGrid3d,
 };
 
 /// One benchmarked structure: a name and how to make it empty for a scene.
@@ -86,6 +87,7 @@ pub fn entries() -> Vec<Entry> {
         )),
         proxima!("UniformGrid2d", |s| UniformGrid2d::new(s.world, s.r_max)),
         proxima!("HashGrid", |s| HashGrid::new(s.r_max)),
+        proxima!("UniformGrid3d", |s| UniformGrid3d::new(s.world, s.r_max)),
         Entry {
             name: PARRY,
             quadratic: false,

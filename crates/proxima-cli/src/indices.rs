@@ -7,6 +7,7 @@
 
 use proxima::broad::{
     BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex, UniformGrid2d,
+    UniformGrid3d,
 };
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::Vec3;
@@ -138,6 +139,7 @@ registry! {
     "octree" => octree,
     "grid2d" => |h| UniformGrid2d::<u64>::new(h.world, h.r_max),
     "hashgrid" => |h| HashGrid::<u64>::new(h.r_max),
+    "grid3d" => |h| UniformGrid3d::<u64>::new(h.world, h.r_max),
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@
 //! | [`LinearOctree`] | sparse octree named by location codes in a hash map; O(1) face-neighbour codes, moves via neighbours, split/merge with hysteresis, loose bounds by max extent | seed 004 |
 //! | [`LooseKdTree`] | binary tree with overlapping children (shared border zone); each sphere in exactly one node | seed 000 (`SPHERE_SET_TREE`) |
 //! | [`HashGrid`] | unbounded 3D hashed grid; huge objects in an oversized list | seed 000 (3D) |
+//! | [`UniformGrid3d`] | dense uniform 3D grid over a world box; each object once, in its centre's cell; half-shell pair search; large objects in a list | seed 000 (3D) |
 //! | [`UniformGrid2d`] | uniform grid on the XY plane for flat worlds; objects referenced from every covered cell | seed 000 |
 //!
 //! Every index stores a [`Sphere`] and a user payload `T` per object and returns a
@@ -16,6 +17,7 @@
 mod brute;
 mod cell_list;
 mod grid2d;
+mod grid3d;
 mod hash_grid;
 pub mod loose_kd;
 pub mod octree;
@@ -28,6 +30,7 @@ mod test_util;
 pub use crate::arena::Handle;
 pub use brute::BruteForce;
 pub use grid2d::UniformGrid2d;
+pub use grid3d::UniformGrid3d;
 pub use hash_grid::HashGrid;
 pub use loose_kd::LooseKdTree;
 pub use octree::{LinearOctree, OctreeConfig};

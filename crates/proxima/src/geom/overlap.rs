@@ -112,6 +112,27 @@ pub fn sphere_sphere(a: &Sphere, b: &Sphere) -> bool {
     within(a.center, b.center, a.radius, b.radius)
 }
 
+/// Four sphere–sphere prefilters at once, for pair searches over lanes of
+/// spheres (lane `i` has centre `(xs[i], ys[i], zs[i])` and radius `rs[i]`):
+/// bit `i` of the result is clear only if `a` and lane `i` certainly do not
+/// overlap, so a search may skip cleared lanes and must decide set ones with
+/// [`sphere_sphere`]. SIMD on `glam`'s `Vec4` (SSE2); O(1).
+///
+/// It rejects only gaps wider than 1e-4 of `|d|² + (r1 + r2)²`, 250× the
+/// relative error of the `f32` evaluation, so no overlapping pair is rejected;
+/// NaN and overflow (∞ > ∞ is false) keep the lane.
+#[inline]
+pub fn sphere_sphere_maybe4(a: &Sphere, xs: Vec4, ys: Vec4, zs: Vec4, rs: Vec4) -> u32 {
+    let dx = Vec4::splat(a.center.x) - xs;
+    let dy = Vec4::splat(a.center.y) - ys;
+    let dz = Vec4::splat(a.center.z) - zs;
+    let d2 = dx * dx + dy * dy + dz * dz;
+    let r = Vec4::splat(a.radius) + rs;
+    let r2 = r * r;
+    let bound = r2 + (Vec4::splat(1e-4) * (d2 + r2) + Vec4::splat(1e-30));
+    (!d2.cmpgt(bound)).bitmask()
+}
+
 /// Sphere–AABB: the distance from the centre to the box (its closest point) is at
 /// most `r`, decided exactly.
 #[inline]
@@ -355,6 +376,48 @@ mod tests {
 
     use super::*;
     use glam::{vec3, Mat4};
+
+    /// The 4-lane prefilter never clears a lane that overlaps, at any magnitude,
+    /// and clears most of those far apart.
+    #[test]
+    fn maybe4_never_rejects_an_overlap() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
+        let mut cleared = 0;
+        for k in 0..20_000 {
+            let scale = [1e-20f32, 1e-3, 1.0, 1e3, 1e18, 1e30][k % 6];
+            let mut v = || rng.gen_range(-4.0f32..4.0) * scale;
+            let a = Sphere::new(vec3(v(), v(), v()), v().abs());
+            let lanes: Vec<Sphere> = (0..4)
+                .map(|_| Sphere::new(vec3(v(), v(), v()), v().abs()))
+                .collect();
+            let col = |f: fn(&Sphere) -> f32| Vec4::from_array([0, 1, 2, 3].map(|i| f(&lanes[i])));
+            let bits = sphere_sphere_maybe4(
+                &a,
+                col(|s| s.center.x),
+                col(|s| s.center.y),
+                col(|s| s.center.z),
+                col(|s| s.radius),
+            );
+            for (i, l) in lanes.iter().enumerate() {
+                if bits & (1 << i) == 0 {
+                    assert!(!sphere_sphere(&a, l), "{a:?} {l:?}");
+                    cleared += 1;
+                }
+            }
+        }
+        assert!(cleared > 20_000, "{cleared}");
+        // Touching spheres on a coarse grid (exact ties) are kept.
+        let a = Sphere::new(Vec3::ZERO, 1.0);
+        let bits = sphere_sphere_maybe4(
+            &a,
+            Vec4::new(2.0, 0.0, 3.0, 1.0),
+            Vec4::ZERO,
+            Vec4::ZERO,
+            Vec4::ONE,
+        );
+        assert_eq!(bits, 0b1011);
+    }
 
     /// The `f32` filter of `within` never decides differently from the exact
     /// predicate: on a coarse grid exact ties are common, and magnitudes up to

@@ -4,7 +4,7 @@
 mod harness;
 
 use harness::{run, SceneParams, ALL_SCENES};
-use proxima::broad::{BruteForce, HashGrid, LooseKdTree, UniformGrid2d};
+use proxima::broad::{BruteForce, HashGrid, LooseKdTree, UniformGrid2d, UniformGrid3d};
 
 /// Number of random operations per scene and seed.
 const OPS: usize = 6000;
@@ -42,3 +42,7 @@ oracle_suite!(grid2d, |p: &SceneParams| UniformGrid2d::new(
 )
 .unwrap());
 oracle_suite!(hash_grid, |p: &SceneParams| HashGrid::new(p.r_max).unwrap());
+oracle_suite!(grid3d, |p: &SceneParams| UniformGrid3d::new(
+    p.world, p.r_max
+)
+.unwrap());

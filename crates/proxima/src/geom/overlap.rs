@@ -112,27 +112,6 @@ pub fn sphere_sphere(a: &Sphere, b: &Sphere) -> bool {
     within(a.center, b.center, a.radius, b.radius)
 }
 
-/// Four sphere–sphere prefilters at once, for pair searches over lanes of
-/// spheres (lane `i` has centre `(xs[i], ys[i], zs[i])` and radius `rs[i]`):
-/// bit `i` of the result is clear only if `a` and lane `i` certainly do not
-/// overlap, so a search may skip cleared lanes and must decide set ones with
-/// [`sphere_sphere`]. SIMD on `glam`'s `Vec4` (SSE2); O(1).
-///
-/// It rejects only gaps wider than 1e-4 of `|d|² + (r1 + r2)²`, 250× the
-/// relative error of the `f32` evaluation, so no overlapping pair is rejected;
-/// NaN and overflow (∞ > ∞ is false) keep the lane.
-#[inline]
-pub fn sphere_sphere_maybe4(a: &Sphere, xs: Vec4, ys: Vec4, zs: Vec4, rs: Vec4) -> u32 {
-    let dx = Vec4::splat(a.center.x) - xs;
-    let dy = Vec4::splat(a.center.y) - ys;
-    let dz = Vec4::splat(a.center.z) - zs;
-    let d2 = dx * dx + dy * dy + dz * dz;
-    let r = Vec4::splat(a.radius) + rs;
-    let r2 = r * r;
-    let bound = r2 + (Vec4::splat(1e-4) * (d2 + r2) + Vec4::splat(1e-30));
-    (!d2.cmpgt(bound)).bitmask()
-}
-
 /// Sphere–AABB: the distance from the centre to the box (its closest point) is at
 /// most `r`, decided exactly.
 #[inline]
@@ -380,7 +359,7 @@ mod tests {
     /// The 4-lane prefilter never clears a lane that overlaps, at any magnitude,
     /// and clears most of those far apart.
     #[test]
-    fn maybe4_never_rejects_an_overlap() {
+    fn candidates4_never_rejects_an_overlap_at_any_magnitude() {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
         let mut cleared = 0;
@@ -392,12 +371,12 @@ mod tests {
                 .map(|_| Sphere::new(vec3(v(), v(), v()), v().abs()))
                 .collect();
             let col = |f: fn(&Sphere) -> f32| Vec4::from_array([0, 1, 2, 3].map(|i| f(&lanes[i])));
-            let bits = sphere_sphere_maybe4(
-                &a,
+            let bits = sphere_sphere_candidates4(
                 col(|s| s.center.x),
                 col(|s| s.center.y),
                 col(|s| s.center.z),
                 col(|s| s.radius),
+                &a,
             );
             for (i, l) in lanes.iter().enumerate() {
                 if bits & (1 << i) == 0 {
@@ -409,12 +388,12 @@ mod tests {
         assert!(cleared > 20_000, "{cleared}");
         // Touching spheres on a coarse grid (exact ties) are kept.
         let a = Sphere::new(Vec3::ZERO, 1.0);
-        let bits = sphere_sphere_maybe4(
-            &a,
+        let bits = sphere_sphere_candidates4(
             Vec4::new(2.0, 0.0, 3.0, 1.0),
             Vec4::ZERO,
             Vec4::ZERO,
             Vec4::ONE,
+            &a,
         );
         assert_eq!(bits, 0b1011);
     }

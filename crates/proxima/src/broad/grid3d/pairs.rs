@@ -164,7 +164,7 @@ impl Window {
 #[inline(always)]
 fn maybe4(a: &Sphere, l: &Lanes) -> u32 {
     let [x, y, z, r] = l.map(Vec4::from_array);
-    overlap::sphere_sphere_maybe4(a, x, y, z, r)
+    overlap::sphere_sphere_candidates4(x, y, z, r, a)
 }
 
 /// Sphere of lane `i`.
@@ -183,7 +183,7 @@ impl<T> UniformGrid3d<T> {
     /// itself (pairs `i < j`) and its forward neighbours, so every pair of cells
     /// — and every pair of objects — is met exactly once. Each object is tested
     /// against a whole neighbour cell at once with a SIMD prefilter
-    /// ([`overlap::sphere_sphere_maybe4`]); what it keeps is decided by
+    /// ([`overlap::sphere_sphere_candidates4`]); what it keeps is decided by
     /// [`overlap::sphere_sphere`]. Cost O(cells in range + look-ahead + Σ k·k'),
     /// streaming through the cell arrays in memory order.
     pub(super) fn visit_pairs(

@@ -21,4 +21,5 @@ pub mod registry;
 pub mod report;
 pub mod run;
 pub mod structure;
+pub mod w4;
 pub mod workloads;

@@ -76,6 +76,9 @@ fn num<T: std::str::FromStr>(s: &str) -> Result<T, String> {
 }
 
 fn main() -> ExitCode {
+    if std::env::args().nth(1).as_deref() == Some("w4") {
+        return proxima_bench::w4::main(std::env::args().skip(2));
+    }
     let args = match parse(std::env::args().skip(1)) {
         Ok(a) => a,
         Err(e) => {

@@ -1,9 +1,10 @@
-//! `proxima-bench w4 [--n N] [--queries Q] [--frusta F] [--reps R] [--threads K] [--seed S] [--clock cpu|wall] [--json]`
+//! `proxima-bench w4 [--n N] [--queries Q] [--frusta F] [--reps R] [--threads K] [--seed S] [--clock cpu|wall] [--only A,B] [--order morton|input] [--json]`
 //!
 //! W4 (design §5): queries on a static set. W1's spheres (radii in `[0.5, 2]`,
 //! centres uniform in a cube of side `4·N^(1/3)`) are loaded once into every
-//! structure (build timed), then each query kind runs as a batch ([`queries`]),
-//! `R` times; the table gives the median batch time per query, the hits per batch
+//! structure (build timed; Proxima's indices are loaded by inserting in Morton
+//! order of the centres, `--order input` for the generated order), then each
+//! query kind runs as a batch ([`queries`]), `R` times; the table gives the median batch time per query, the hits per batch
 //! (checked equal across all structures — exit 1 otherwise), bytes per object and
 //! the time relative to the best peer for that kind.
 //!
@@ -30,7 +31,7 @@ use queries::QueryKind;
 use std::fmt::Write;
 use std::time::Duration;
 
-const USAGE: &str = "usage: proxima-bench w4 [--n N] [--queries Q] [--frusta F] [--reps R] [--threads K] [--seed S] [--clock cpu|wall] [--json]";
+const USAGE: &str = "usage: proxima-bench w4 [--n N] [--queries Q] [--frusta F] [--reps R] [--threads K] [--seed S] [--clock cpu|wall] [--only A,B] [--order morton|input] [--json]";
 
 /// W4's options.
 #[derive(Clone, Debug)]
@@ -51,6 +52,11 @@ pub struct Args {
     pub clock: Clock,
     /// JSON instead of the table.
     pub json: bool,
+    /// Only these structures (all when empty).
+    pub only: Vec<String>,
+    /// Insert into Proxima's indices in Morton order (`--order morton`, the
+    /// default) or in input order (`--order input`).
+    pub morton: bool,
 }
 
 fn num<T: std::str::FromStr>(s: &str) -> Result<T, String> {
@@ -70,6 +76,8 @@ pub fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         seed: 1,
         clock: Clock::ThreadCpu,
         json: false,
+        only: Vec::new(),
+        morton: true,
     };
     while let Some(flag) = it.next() {
         let mut value = |name: &str| it.next().ok_or(format!("{name} needs a value"));
@@ -88,6 +96,20 @@ pub fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                 }
             }
             "--json" => a.json = true,
+            "--order" => {
+                a.morton = match value("--order")?.as_str() {
+                    "morton" => true,
+                    "input" => false,
+                    other => return Err(format!("--order takes morton or input, not {other:?}")),
+                }
+            }
+            "--only" => {
+                a.only = value("--only")?
+                    .split(',')
+                    .filter(|s| !s.is_empty())
+                    .map(String::from)
+                    .collect()
+            }
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument {other:?}")),
         }
@@ -107,7 +129,17 @@ struct Entry {
     name: &'static str,
     peer: bool,
     quadratic: bool,
-    build: fn(&[proxima::geom::Sphere], &crate::workloads::Scene) -> Box<dyn Engine>,
+    build: fn(&[proxima::geom::Sphere], &crate::workloads::Scene, bool) -> Box<dyn Engine>,
+}
+
+/// Insertion order of Proxima's indices: Morton order of the centres (their bulk
+/// load; the peers' bulk builds sort spatially too) or the input order.
+fn order(s: &[proxima::geom::Sphere], morton: bool) -> Vec<u32> {
+    if morton {
+        engine::morton_order(s)
+    } else {
+        (0..s.len() as u32).collect()
+    }
 }
 
 fn entries() -> Vec<Entry> {
@@ -116,67 +148,67 @@ fn entries() -> Vec<Entry> {
             name: "BruteForce",
             peer: false,
             quadratic: true,
-            build: |s, _| Box::new(Proxima::build(BruteForce::new(), s)),
+            build: |s, _, m| Box::new(Proxima::build(BruteForce::new(), s, &order(s, m))),
         },
         Entry {
             name: "LooseKdTree",
             peer: false,
             quadratic: false,
-            build: |s, sc| {
+            build: |s, sc, m| {
                 let t = LooseKdTree::new(sc.world, sc.r_max, loose_kd::DEFAULT_DENSITY);
-                Box::new(Proxima::build(t.expect("kd params"), s))
+                Box::new(Proxima::build(t.expect("kd params"), s, &order(s, m)))
             },
         },
         Entry {
             name: "LinearOctree",
             peer: false,
             quadratic: false,
-            build: |s, sc| {
+            build: |s, sc, m| {
                 let t = LinearOctree::new(sc.world, OctreeConfig::default());
-                Box::new(Proxima::build(t.expect("octree params"), s))
+                Box::new(Proxima::build(t.expect("octree params"), s, &order(s, m)))
             },
         },
         Entry {
             name: "HashGrid",
             peer: false,
             quadratic: false,
-            build: |s, sc| {
+            build: |s, sc, m| {
                 let t = HashGrid::new(sc.r_max).expect("grid params");
-                Box::new(Proxima::build(t, s))
+                Box::new(Proxima::build(t, s, &order(s, m)))
             },
         },
         Entry {
             name: "UniformGrid2d",
             peer: false,
             quadratic: false,
-            build: |s, sc| {
+            build: |s, sc, m| {
                 let t = UniformGrid2d::new(sc.world, sc.r_max).expect("grid params");
-                Box::new(Proxima::build(t, s))
+                Box::new(Proxima::build(t, s, &order(s, m)))
             },
         },
         Entry {
             name: "parry3d",
             peer: true,
             quadratic: false,
-            build: |s, _| Box::new(parry_peer::ParryQuery::build(s)),
+            build: |s, _, _| Box::new(parry_peer::ParryQuery::build(s)),
         },
         Entry {
             name: "rstar",
             peer: true,
             quadratic: false,
-            build: |s, _| Box::new(rstar_peer::RstarQuery::build(s)),
+            build: |s, _, _| Box::new(rstar_peer::RstarQuery::build(s)),
         },
         Entry {
             name: "kiddo",
             peer: true,
             quadratic: false,
-            build: |s, _| Box::new(kiddo_peer::KiddoQuery::build(s)),
+            build: |s, _, _| Box::new(kiddo_peer::KiddoQuery::build(s)),
         },
         Entry {
             name: "bvh",
             peer: true,
             quadratic: false,
-            build: |s, _| Box::new(bvh_peer::BvhQuery::build(s)),
+            build: |s, _, _| Box::new(bvh_peer::BvhQuery::build(s)),
         },
     ]
 }
@@ -225,11 +257,12 @@ pub fn run(a: &Args) -> (Vec<(QueryKind, Vec<Row>)>, Vec<String>) {
     let mut reference: Vec<Option<(u64, u64, &'static str)>> = vec![None; QueryKind::ALL.len()];
     let mut errors = Vec::new();
     for e in entries() {
-        if e.quadratic && a.n > QUADRATIC_LIMIT {
+        let wanted = a.only.is_empty() || a.only.iter().any(|o| o.eq_ignore_ascii_case(e.name));
+        if !wanted || (e.quadratic && a.n > QUADRATIC_LIMIT) {
             continue;
         }
         eprintln!("running {} ...", e.name);
-        let (engine, build) = a.clock.time(|| (e.build)(&w.spheres, &scene));
+        let (engine, build) = a.clock.time(|| (e.build)(&w.spheres, &scene, a.morton));
         let bytes = engine.memory_bytes() as f64 / a.n as f64;
         for (k, (kind, out)) in rows.iter_mut().enumerate() {
             let mut row = Row {
@@ -431,7 +464,7 @@ pub fn main(args: impl Iterator<Item = String>) -> std::process::ExitCode {
         print!("{}", json(&a, len, &rows));
     } else {
         println!(
-            "w4 n={} queries={} frusta={} reps={} threads={} seed={} clock={} (median batch time; hits checked equal across structures{})",
+            "w4 n={} queries={} frusta={} reps={} threads={} seed={} clock={} order={} (median batch time; hits checked equal across structures{})",
             a.n,
             a.queries,
             a.frusta,
@@ -439,6 +472,7 @@ pub fn main(args: impl Iterator<Item = String>) -> std::process::ExitCode {
             a.threads,
             a.seed,
             a.clock.name(),
+            if a.morton { "morton" } else { "input" },
             if a.n > QUADRATIC_LIMIT { "; BruteForce skipped above 20000" } else { "" }
         );
         print!("{}", table(&a, len, &rows));

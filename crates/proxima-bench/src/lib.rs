@@ -30,6 +30,7 @@ pub mod registry;
 pub mod report;
 pub mod run;
 pub mod structure;
+pub mod w4;
 pub mod w5;
 pub mod w6;
 pub mod workloads;

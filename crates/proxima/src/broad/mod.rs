@@ -35,7 +35,7 @@ pub use hash_grid::HashGrid;
 pub use loose_kd::LooseKdTree;
 pub use octree::{LinearOctree, OctreeConfig};
 #[cfg(feature = "parallel")]
-pub use parallel::ParallelPairs;
+pub use parallel::{par_query_counts, par_visit_batch, ParallelPairs};
 pub use selection::Selection;
 
 use crate::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};

@@ -5,8 +5,11 @@
 //! Results are combined rayon-style (`init` / `fold` / `reduce`), so each thread
 //! accumulates into its own value and nothing is shared while pairs are found.
 
-use super::{Handle, SpatialIndex};
+use super::{Handle, Selection, SpatialIndex};
+use crate::geom::Sphere;
+use crate::Result;
 use rayon::prelude::*;
+use std::ops::ControlFlow;
 
 /// Pair finding split across rayon's threads.
 ///
@@ -43,5 +46,214 @@ pub trait ParallelPairs<T: Sync>: SpatialIndex<T> {
         );
         out.par_sort_unstable();
         out
+    }
+}
+
+/// Validates every query of a batch, so a batch query fails before any work with
+/// the error of the first bad query (and the index is only read, never changed).
+fn validate_all<Q: Selection + Sync>(queries: &[Q]) -> Result<()> {
+    queries.iter().try_for_each(|q| q.validate())
+}
+
+/// Number of objects each query selects, `out[i]` for `queries[i]`, the queries
+/// split over rayon's threads (one [`SpatialIndex::visit`] per query; the index is
+/// shared read-only, which its `Sync` bound allows). Cost: the sequential queries
+/// divided over the pool's threads. Errors, before any query runs, if a query's
+/// numbers are invalid.
+pub fn par_query_counts<T, I, Q>(index: &I, queries: &[Q]) -> Result<Vec<usize>>
+where
+    I: SpatialIndex<T>,
+    Q: Selection + Sync,
+{
+    validate_all(queries)?;
+    Ok(queries
+        .par_iter()
+        .map(|q| {
+            let mut n = 0usize;
+            let _ = index.visit(q, |_, _, _| {
+                n += 1;
+                ControlFlow::Continue(())
+            });
+            n
+        })
+        .collect())
+}
+
+/// Folds every (query, selected object) of a batch into per-task accumulators made
+/// by `init` — `fold(acc, i, handle, sphere, value)` with `i` the query's position
+/// in `queries` — then merges them with `reduce` (rayon's fold/reduce). Objects are
+/// reported in no particular order across queries. Cost: the sequential queries
+/// divided over the pool's threads plus one `reduce` per task. Errors, before any
+/// query runs, if a query's numbers are invalid.
+pub fn par_visit_batch<T, I, Q, A, Init, F, R>(
+    index: &I,
+    queries: &[Q],
+    init: Init,
+    fold: F,
+    reduce: R,
+) -> Result<A>
+where
+    I: SpatialIndex<T>,
+    Q: Selection + Sync,
+    A: Send,
+    Init: Fn() -> A + Sync + Send,
+    F: Fn(A, usize, Handle, &Sphere, &T) -> A + Sync + Send,
+    R: Fn(A, A) -> A + Sync + Send,
+{
+    validate_all(queries)?;
+    Ok(queries
+        .par_iter()
+        .enumerate()
+        .fold(&init, |acc, (i, q)| {
+            // `visit` takes an `FnMut`, so the accumulator moves through an Option.
+            let mut acc = Some(acc);
+            let _ = index.visit(q, |h, s, v| {
+                acc = acc.take().map(|a| fold(a, i, h, s, v));
+                ControlFlow::Continue(())
+            });
+            acc.expect("the accumulator is put back after every object")
+        })
+        .reduce(&init, &reduce))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::broad::{BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig};
+    use crate::geom::{Aabb, Frustum, Ray};
+    use crate::Error;
+    use glam::{Mat4, Vec3};
+
+    /// A deterministic stream in `[0, 1)`.
+    fn rng(mut seed: u32) -> impl FnMut() -> f32 {
+        move || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32
+        }
+    }
+
+    fn fill<I: SpatialIndex<u32>>(index: &mut I) {
+        let mut next = rng(11);
+        for i in 0..3000u32 {
+            let c = Vec3::new(next(), next(), next()) * 60.0;
+            let h = index.insert(Sphere::new(c, 0.2 + 2.0 * next()), i).unwrap();
+            if i % 10 == 0 {
+                index.remove(h).unwrap();
+            }
+        }
+    }
+
+    /// Sequential reference: the per-query handle lists, sorted.
+    fn sequential<T, I: SpatialIndex<T>, Q: Selection>(index: &I, qs: &[Q]) -> Vec<Vec<Handle>> {
+        qs.iter()
+            .map(|q| {
+                let mut v = Vec::new();
+                let _ = index.visit(q, |h, _, _| {
+                    v.push(h);
+                    ControlFlow::Continue(())
+                });
+                v.sort();
+                v
+            })
+            .collect()
+    }
+
+    fn check<I: SpatialIndex<u32>, Q: Selection + Sync>(index: &I, qs: &[Q]) {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let seq = sequential(index, qs);
+        let total: usize = seq.iter().map(Vec::len).sum();
+        assert!(total > qs.len(), "the batch must select things: {total}");
+        let counts = pool.install(|| par_query_counts(index, qs)).unwrap();
+        assert_eq!(counts, seq.iter().map(Vec::len).collect::<Vec<_>>());
+        let mut lists = pool
+            .install(|| {
+                par_visit_batch(
+                    index,
+                    qs,
+                    || vec![Vec::new(); qs.len()],
+                    |mut acc: Vec<Vec<Handle>>, i, h, _, _| {
+                        acc[i].push(h);
+                        acc
+                    },
+                    |mut a, b| {
+                        for (x, y) in a.iter_mut().zip(b) {
+                            x.extend(y);
+                        }
+                        a
+                    },
+                )
+            })
+            .unwrap();
+        lists.iter_mut().for_each(|l| l.sort());
+        assert_eq!(lists, seq);
+    }
+
+    fn batches<I: SpatialIndex<u32>>(index: &I) {
+        let mut next = rng(5);
+        let mut p = || Vec3::new(next(), next(), next()) * 64.0 - 2.0;
+        let spheres: Vec<_> = (0..300).map(|_| Sphere::new(p(), 4.0)).collect();
+        let boxes: Vec<_> = (0..300)
+            .map(|_| {
+                let c = p();
+                Aabb::new(c - 3.0, c + Vec3::new(5.0, 2.0, 4.0))
+            })
+            .collect();
+        let rays: Vec<_> = (0..300)
+            .map(|i| {
+                let (o, d) = (p(), p() - 30.0);
+                if i % 2 == 0 {
+                    Ray::new(o, d)
+                } else {
+                    Ray::with_max_t(o, d, 0.3)
+                }
+            })
+            .collect();
+        let frusta: Vec<_> = (0..20)
+            .map(|_| {
+                let view = Mat4::look_at_rh(p(), p(), Vec3::Z);
+                let proj = Mat4::perspective_rh(1.0, 1.5, 0.1, 30.0);
+                Frustum::from_view_projection(proj * view).unwrap()
+            })
+            .collect();
+        check(index, &spheres);
+        check(index, &boxes);
+        check(index, &rays);
+        check(index, &frusta);
+    }
+
+    #[test]
+    fn batch_queries_in_a_two_thread_pool_equal_sequential_ones() {
+        let world = Aabb::new(Vec3::ZERO, Vec3::splat(60.0));
+        let mut brute = BruteForce::new();
+        fill(&mut brute);
+        batches(&brute);
+        let mut kd = LooseKdTree::new(world, 2.2, 0.25).unwrap();
+        fill(&mut kd);
+        batches(&kd);
+        let mut oct = LinearOctree::new(world, OctreeConfig::default()).unwrap();
+        fill(&mut oct);
+        batches(&oct);
+        let mut grid = HashGrid::new(2.2).unwrap();
+        fill(&mut grid);
+        batches(&grid);
+    }
+
+    #[test]
+    fn a_bad_query_fails_the_batch_before_any_work() {
+        let mut kd = LooseKdTree::new(Aabb::new(Vec3::ZERO, Vec3::ONE), 1.0, 0.25).unwrap();
+        kd.insert(Sphere::new(Vec3::ZERO, 1.0), 0u32).unwrap();
+        let qs = [
+            Sphere::new(Vec3::ZERO, 1.0),
+            Sphere::new(Vec3::ZERO, f32::NAN),
+        ];
+        let bad = Err(Error::NonFinite {
+            what: "sphere radius",
+        });
+        assert_eq!(par_query_counts(&kd, &qs), bad);
+        let r = par_visit_batch(&kd, &qs, || 0, |n, _, _, _, _: &u32| n + 1, |a, b| a + b);
+        assert_eq!(r, bad.map(|_: Vec<usize>| 0));
     }
 }

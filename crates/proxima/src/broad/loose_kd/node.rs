@@ -156,9 +156,16 @@ impl<T> LooseKdTree<T> {
     /// exact tests of `geom::overlap` on a sphere that touches a face.
     #[inline]
     pub(super) fn region(&self, n: &Node<T>) -> Aabb {
+        self.region_of_box(&n.bbox)
+    }
+
+    /// [`LooseKdTree::region`] of the node whose box is `bbox`: lets a walk derive
+    /// a child's region from its parent without loading the child.
+    #[inline]
+    pub(super) fn region_of_box(&self, bbox: &Aabb) -> Aabb {
         let e = Vec3::splat(self.eps);
-        let min = Vec3::select(n.bbox.min.cmpeq(self.world.min), self.span.min, n.bbox.min);
-        let max = Vec3::select(n.bbox.max.cmpeq(self.world.max), self.span.max, n.bbox.max);
+        let min = Vec3::select(bbox.min.cmpeq(self.world.min), self.span.min, bbox.min);
+        let max = Vec3::select(bbox.max.cmpeq(self.world.max), self.span.max, bbox.max);
         Aabb::new(min - e, max + e)
     }
 

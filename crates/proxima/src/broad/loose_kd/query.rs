@@ -17,19 +17,33 @@ struct Pending {
     inside: bool,
 }
 
+/// A subtree known to be wholly selected.
+#[inline]
+fn p_inside(node: u32) -> Pending {
+    Pending {
+        node,
+        mask: 0,
+        inside: true,
+    }
+}
+
 impl<T> LooseKdTree<T> {
     /// Depth-first walk reporting every item `query` selects.
     ///
-    /// Per child, two conservative filters:
+    /// Per child, two conservative filters, both decided from the *parent* (already
+    /// in cache), so a pruned child's node is never loaded — on a large tree each
+    /// node load is a cache miss, and it is what the profile of W4's queries shows:
     /// 1. the seed's one comparison on the split axis against `query.bounds()`
     ///    (descend positive only if `q_max_a >= m - h`, negative only if
     ///    `q_min_a <= m + h`, each with slack): every sphere of the positive subtree
     ///    has `c_a - r > m - h`, so a query box ending before `m - h` selects none
     ///    of them (bounds are a box every selected sphere intersects);
-    /// 2. `query.classify_box` on the child's region (`region`, which contains every
-    ///    sphere of the subtree), carrying the frustum plane mask down: `Outside`
-    ///    skips the subtree, `Inside` reports it whole without tests (valid because
-    ///    the selection promises `Inside` only when every sphere inside the box is
+    /// 2. `query.classify_box` on the child's region (its box is the parent's with
+    ///    one face moved, [`Node::child_bounds`](super::node::Node::child_bounds),
+    ///    an invariant `validate` checks; the region contains every sphere of the
+    ///    subtree), carrying the frustum plane mask down: `Outside` skips the
+    ///    subtree, `Inside` reports it whole without tests (valid because the
+    ///    selection promises `Inside` only when every sphere inside the box is
     ///    selected). Queries without bounds (frustums) rely on this one alone.
     pub(super) fn visit_impl<Q: Selection + ?Sized>(
         &self,
@@ -41,42 +55,43 @@ impl<T> LooseKdTree<T> {
         }
         let bounds = query.bounds();
         let mut stack = FixedStack::<Pending>::new();
-        let classify = |n: u32, mask: u8, stack: &mut FixedStack<Pending>| {
-            let (rel, mask) = query.classify_box(&self.region(&self.nodes[n]), mask);
-            match rel {
+        let push =
+            |node: u32, (rel, mask): (Relation, u8), stack: &mut FixedStack<Pending>| match rel {
                 Relation::Outside => {}
                 Relation::Inside => stack.push(Pending {
-                    node: n,
+                    node,
                     mask: 0,
                     inside: true,
                 }),
                 Relation::Intersecting => stack.push(Pending {
-                    node: n,
+                    node,
                     mask,
                     inside: false,
                 }),
-            }
-        };
-        classify(self.root, Frustum::ALL_PLANES, &mut stack);
+            };
+        let root = &self.nodes[self.root];
+        push(
+            self.root,
+            query.classify_box(&self.region(root), Frustum::ALL_PLANES),
+            &mut stack,
+        );
         while let Some(p) = stack.pop() {
             let node = &self.nodes[p.node];
-            for slot in &node.slots {
-                if p.inside || query.selects(&slot.sphere) {
+            if p.inside {
+                for slot in &node.slots {
                     f(slot.handle, &slot.sphere, &slot.value)?;
                 }
+                for c in node.child {
+                    if c != NIL {
+                        stack.push(p_inside(c));
+                    }
+                }
+                continue;
             }
             let a = node.axis as usize;
             for side in 0..2 {
                 let c = node.child[side];
                 if c == NIL {
-                    continue;
-                }
-                if p.inside {
-                    stack.push(Pending {
-                        node: c,
-                        mask: 0,
-                        inside: true,
-                    });
                     continue;
                 }
                 if let Some(b) = &bounds {
@@ -89,7 +104,26 @@ impl<T> LooseKdTree<T> {
                         continue;
                     }
                 }
-                classify(c, p.mask, &mut stack);
+                // The child's box, from the parent: one face moved to `m ∓ h`.
+                let mut cb = node.bbox;
+                if side == 1 {
+                    cb.min[a] = node.m - node.h;
+                } else {
+                    cb.max[a] = node.m + node.h;
+                }
+                push(
+                    c,
+                    query.classify_box(&self.region_of_box(&cb), p.mask),
+                    &mut stack,
+                );
+            }
+            // The node's own objects after its children are classified: the
+            // children's tests need only this node's fields, and the scan's
+            // first load (the object list, a separate allocation) is the miss.
+            for slot in &node.slots {
+                if query.selects(&slot.sphere) {
+                    f(slot.handle, &slot.sphere, &slot.value)?;
+                }
             }
         }
         ControlFlow::Continue(())

@@ -64,9 +64,19 @@ impl<T> LinearOctree<T> {
                     }
                 } else {
                     for (k, &ch) in n.children.iter().enumerate() {
-                        if ch != NONE {
-                            self.visit_node(ch, child_coords(c, k), d + 1, mask, q, f)?;
+                        if ch == NONE {
+                            continue;
                         }
+                        // Pre-test with this node's extent (never below a child's):
+                        // a box containing the child's loose box, so `Outside` here
+                        // is `Outside` there, decided without loading the child —
+                        // on a large tree each node load is a cache miss.
+                        let cc = child_coords(c, k);
+                        let outer = self.loose_of(cc, d + 1, n.max_extent);
+                        if q.classify_box(&outer, mask).0 == Relation::Outside {
+                            continue;
+                        }
+                        self.visit_node(ch, cc, d + 1, mask, q, f)?;
                     }
                 }
                 ControlFlow::Continue(())

@@ -1,0 +1,169 @@
+//! One object-safe interface over every structure W4 queries: Proxima's indices
+//! (through [`Proxima`], generic over [`SpatialIndex<u32>`]) and the peers.
+//!
+//! Every answer is exact and closed: a peer's own traversal yields candidates
+//! (AABB, ray or point-radius hits), and the same tests of `proxima::geom::overlap`
+//! (through [`Selection::selects`]) filter them, so hit counts are comparable.
+
+use super::queries::{Batches, QueryKind};
+use proxima::broad::{par_query_counts, Selection, SpatialIndex};
+use proxima::geom::Sphere;
+use rayon::prelude::*;
+use std::ops::ControlFlow;
+
+/// A structure built once over the set, then queried.
+pub trait Engine: Sync {
+    /// Hits of one query of `kind` (query `i` of that batch), or `None` when the
+    /// structure has no such query.
+    fn count(&self, batches: &Batches, kind: QueryKind, i: usize) -> Option<usize>;
+
+    /// Whether the structure answers queries of `kind`.
+    fn supports(&self, kind: QueryKind) -> bool;
+
+    /// Hits of every query of a batch: sequential on the calling thread, or over
+    /// rayon's current pool when `parallel`.
+    fn counts(&self, batches: &Batches, kind: QueryKind, parallel: bool) -> Option<Vec<usize>> {
+        if !self.supports(kind) {
+            return None;
+        }
+        let one = |i| self.count(batches, kind, i).expect("supported kind");
+        let n = batches.len(kind);
+        Some(if parallel {
+            (0..n).into_par_iter().map(one).collect()
+        } else {
+            (0..n).map(one).collect()
+        })
+    }
+
+    /// Bytes held by the structure, its copy of the spheres included (an estimate
+    /// where the crate does not say).
+    fn memory_bytes(&self) -> usize;
+}
+
+/// Hits of `q` in `index` through the generic `visit`.
+#[inline]
+pub fn visit_count<I: SpatialIndex<u32>, Q: Selection + ?Sized>(index: &I, q: &Q) -> usize {
+    let mut n = 0usize;
+    let _ = index.visit(q, |_, _, _| {
+        n += 1;
+        ControlFlow::Continue(())
+    });
+    n
+}
+
+/// Any Proxima index: built by inserting sphere `i` with payload `i`, queried with
+/// `SpatialIndex::visit` (sequential) or `broad::par_query_counts` (parallel).
+pub struct Proxima<I>(pub I);
+
+impl<I: SpatialIndex<u32>> Proxima<I> {
+    /// Inserts every sphere into the empty `index`, in the given order (sphere
+    /// `i` always gets payload `i`).
+    pub fn build(mut index: I, spheres: &[Sphere], order: &[u32]) -> Self {
+        for &i in order {
+            let s = &spheres[i as usize];
+            index
+                .insert(*s, i)
+                .unwrap_or_else(|e| panic!("insert of sphere {i} {s:?} failed: {e}"));
+        }
+        Proxima(index)
+    }
+}
+
+/// Spreads the low 10 bits of `v` to every third bit.
+fn spread(v: u32) -> u64 {
+    let mut x = (v & 0x3ff) as u64;
+    x = (x | (x << 16)) & 0x0300_00ff;
+    x = (x | (x << 8)) & 0x0300_f00f;
+    x = (x | (x << 4)) & 0x030c_30c3;
+    (x | (x << 2)) & 0x0924_9249
+}
+
+/// The sphere indices sorted by the Morton (Z-order) code of their centres on a
+/// 1024³ grid over the centres' box: the order a static set is bulk-loaded into
+/// an incremental index, so that nodes and object lists created one after the
+/// other are neighbours in space as well as in memory (the peers' bulk builds
+/// sort spatially too).
+pub fn morton_order(spheres: &[Sphere]) -> Vec<u32> {
+    let (mut lo, mut hi) = (
+        proxima::glam::Vec3::splat(f32::MAX),
+        proxima::glam::Vec3::splat(f32::MIN),
+    );
+    for s in spheres {
+        lo = lo.min(s.center);
+        hi = hi.max(s.center);
+    }
+    let scale = 1023.0 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
+    let code = |s: &Sphere| {
+        let q = ((s.center - lo) * scale).as_uvec3();
+        spread(q.x) | (spread(q.y) << 1) | (spread(q.z) << 2)
+    };
+    let mut order: Vec<u32> = (0..spheres.len() as u32).collect();
+    order.sort_by_key(|&i| code(&spheres[i as usize]));
+    order
+}
+
+impl<I: SpatialIndex<u32>> Engine for Proxima<I> {
+    fn count(&self, b: &Batches, kind: QueryKind, i: usize) -> Option<usize> {
+        Some(match kind {
+            QueryKind::Sphere => visit_count(&self.0, &b.spheres[i]),
+            QueryKind::Aabb => visit_count(&self.0, &b.boxes[i]),
+            QueryKind::Ray => visit_count(&self.0, &b.rays[i]),
+            QueryKind::Frustum => visit_count(&self.0, &b.frusta[i]),
+        })
+    }
+
+    fn supports(&self, _: QueryKind) -> bool {
+        true
+    }
+
+    fn counts(&self, b: &Batches, kind: QueryKind, parallel: bool) -> Option<Vec<usize>> {
+        fn run<I: SpatialIndex<u32>, Q: Selection + Sync>(
+            index: &I,
+            qs: &[Q],
+            parallel: bool,
+        ) -> Vec<usize> {
+            if parallel {
+                par_query_counts(index, qs).expect("valid queries")
+            } else {
+                qs.iter().map(|q| visit_count(index, q)).collect()
+            }
+        }
+        Some(match kind {
+            QueryKind::Sphere => run(&self.0, &b.spheres, parallel),
+            QueryKind::Aabb => run(&self.0, &b.boxes, parallel),
+            QueryKind::Ray => run(&self.0, &b.rays, parallel),
+            QueryKind::Frustum => run(&self.0, &b.frusta, parallel),
+        })
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.0.memory_bytes()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::workloads::{Kind, Workload};
+
+    #[test]
+    fn morton_order_is_a_permutation_that_keeps_neighbours_close() {
+        let w = Workload::new(Kind::W1, 4000, 3);
+        let order = morton_order(&w.spheres);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..4000).collect::<Vec<u32>>());
+        // Consecutive spheres are much closer in Morton order than in input order.
+        let step = |o: &[u32]| -> f32 {
+            o.windows(2)
+                .map(|p| {
+                    w.spheres[p[0] as usize]
+                        .center
+                        .distance(w.spheres[p[1] as usize].center)
+                })
+                .sum()
+        };
+        let input: Vec<u32> = (0..4000).collect();
+        assert!(step(&order) * 4.0 < step(&input));
+    }
+}

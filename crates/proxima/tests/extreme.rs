@@ -536,3 +536,23 @@ fn hash_grid_empty_strip_range() {
     let r = Ray::with_max_t(vec3(-1e12, 0.0, 0.0), vec3(1.0, 0.0, 0.0), 2e12);
     assert_eq!(g.ray_hits(&r).unwrap().len(), b.ray_hits(&r).unwrap().len());
 }
+
+/// Found by the proptest op sequences once far rays were compared: with a cell of
+/// 3e38 the hash grid's loose box of cell y = -2 was `[-∞, -∞]` (its upper side
+/// computed as `min + cell` from an overflowed `min`), so a query with a ball of
+/// radius `f32::MAX` pruned the cell holding an object at y = -3e38.
+#[test]
+fn hash_grid_huge_cell_loose_box() {
+    let big = Sphere::new(vec3(25.25, -21.5, -15.75), f32::MAX);
+    let far = Sphere::new(vec3(-4.25, -3e38, 4352.0), 18.875);
+    let mut g = HashGrid::with_cell_size(3e38).unwrap();
+    let mut b = BruteForce::new();
+    for (i, s) in [big, far].into_iter().enumerate() {
+        g.insert(s, i as u32).unwrap();
+        b.insert(s, i as u32).unwrap();
+    }
+    g.validate().unwrap();
+    assert_eq!(g.pairs().len(), 1);
+    assert_eq!(b.pairs().len(), 1);
+    assert_eq!(g.sphere_hits(&big).unwrap().len(), 2);
+}

@@ -210,6 +210,7 @@ impl<T> HashGrid<T> {
 impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
     fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         sphere.validate()?;
+        self.items.check_room()?;
         let cells = self.cells_of(&sphere);
         let h = self.items.next_handle();
         let slot = h.index();
@@ -224,7 +225,7 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
                 Place::Oversized(self.oversized.len() as u32 - 1)
             }
         };
-        let h2 = self.items.insert(Item { place, value });
+        let h2 = self.items.insert(Item { place, value })?;
         debug_assert_eq!(h, h2);
         if self.handles.len() <= slot as usize {
             self.handles.resize(slot as usize + 1, h);

@@ -96,6 +96,25 @@ fn filtered(v: f64, perm: f64) -> Option<Ordering> {
     }
 }
 
+/// The unit roundoff of `f64`, 2^-53.
+const U: f64 = f64::EPSILON / 2.0;
+
+/// The sign of `lhs - |v|²`, if an `f64` evaluation decides it: `lhs` within
+/// 4u of its value (a product of up to three rounded factors), each `v[k]`
+/// within `err[k]` of its value. An a-posteriori bound (from the computed `v`,
+/// not from the inputs' magnitudes), so a long ray passing near a small sphere
+/// (huge inputs, modest cross product) still decides in `f64`; the bound is
+/// doubled to cover its own rounding.
+#[inline]
+fn square_gap(lhs: f64, v: [f64; 3], err: [f64; 3]) -> Option<Ordering> {
+    let vv = dot(v, v);
+    let mut bound = 4.0 * U * (lhs + vv);
+    for k in 0..3 {
+        bound += (2.0 * v[k].abs() + err[k]) * err[k];
+    }
+    filtered(lhs - vv, 2.0 * bound / FILTER)
+}
+
 #[inline]
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -142,27 +161,29 @@ pub fn ray_sphere(ray: &Ray, s: &Sphere) -> Option<f32> {
             .unwrap_or_else(|| ray_exact::end_minus_closest(ray, s))
             != Ordering::Less;
     let hit = if closest_within {
-        // r²|d|² - |m × d|² >= 0
-        let cr = [
-            m[1] * d[2] - m[2] * d[1],
-            m[2] * d[0] - m[0] * d[2],
-            m[0] * d[1] - m[1] * d[0],
-        ];
-        let cp = [
-            (m[1] * d[2]).abs() + (m[2] * d[1]).abs(),
-            (m[2] * d[0]).abs() + (m[0] * d[2]).abs(),
-            (m[0] * d[1]).abs() + (m[1] * d[0]).abs(),
-        ];
-        let v = r * r * a - dot(cr, cr);
-        let perm = r * r * a + dot(cp, cp);
-        filtered(v, perm).unwrap_or_else(|| ray_exact::line_gap(ray, s)) != Ordering::Less
+        // r²|d|² - |m × d|² >= 0, with m × d = o × d - c × d: the products of
+        // `f32`s are exact in `f64`, so each component rounds only three times,
+        // relative to values that do not include the huge cancelling parts of
+        // `m` (a ray from 1e20 passing 100 units from a sphere still decides).
+        let cross = |p: [f64; 3]| {
+            [
+                p[1] * d[2] - p[2] * d[1],
+                p[2] * d[0] - p[0] * d[2],
+                p[0] * d[1] - p[1] * d[0],
+            ]
+        };
+        let (ox, cx) = (cross(o), cross(c));
+        let cr = [0, 1, 2].map(|k| ox[k] - cx[k]);
+        let err = [0, 1, 2].map(|k| 2.0 * U * (ox[k].abs() + cx[k].abs() + cr[k].abs()));
+        square_gap(r * r * a, cr, err).unwrap_or_else(|| ray_exact::line_gap(ray, s))
+            != Ordering::Less
     } else {
-        // r² - |m + max_t d|² >= 0
-        let p = [0, 1, 2].map(|i| m[i] + big_t * d[i]);
-        let pp = [0, 1, 2].map(|i| m[i].abs() + (big_t * d[i]).abs());
-        let v = r * r - dot(p, p);
-        let perm = r * r + dot(pp, pp);
-        filtered(v, perm).unwrap_or_else(|| ray_exact::end_gap(ray, s)) != Ordering::Less
+        // r² - |o + max_t d - c|² >= 0 (`max_t d` is exact: two `f32`s), two
+        // roundings per component, bounded by the computed values.
+        let e = [0, 1, 2].map(|i| o[i] + big_t * d[i]);
+        let p = [0, 1, 2].map(|i| e[i] - c[i]);
+        let err = [0, 1, 2].map(|i| 2.0 * U * (e[i].abs() + p[i].abs()));
+        square_gap(r * r, p, err).unwrap_or_else(|| ray_exact::end_gap(ray, s)) != Ordering::Less
     };
     if !hit {
         return None;

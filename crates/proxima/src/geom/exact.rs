@@ -146,6 +146,27 @@ impl Exp {
 /// the difference, one of the division; no such quotient leaves the normal range).
 #[inline]
 pub(crate) fn quotient_floor_f32(x: f64, o: f64, d: f64) -> f32 {
+    // Fast path: the rounded quotient `q` is within 2^-51 |q| of the exact one, so
+    // if it is farther than 2^-50 |q| from its nearest `f32` `y` (the difference
+    // is exact), the floor is `y` or the `f32` below. Out of the `f32` range `y`
+    // is ±∞ and the gap infinite: the floor is `f32::MAX` or -∞.
+    let q = (x - o) / d;
+    let y = q as f32;
+    let gap = q - y as f64;
+    let eps = q.abs() * (1.0 / (1u64 << 50) as f64);
+    if gap > eps {
+        return y;
+    }
+    if gap < -eps {
+        return f32_down(y);
+    }
+    quotient_floor_slow(x, o, d)
+}
+
+/// [`quotient_floor_f32`] for a quotient at (or within rounding of) an `f32`.
+#[cold]
+#[inline(never)]
+fn quotient_floor_slow(x: f64, o: f64, d: f64) -> f32 {
     let (s, e) = two_sum(x, -o);
     let q = s / d;
     // (x - o) - q d = (s - q d) + e; `s - q d` is exact (FMA); the sum's sign is.
@@ -153,10 +174,6 @@ pub(crate) fn quotient_floor_f32(x: f64, o: f64, d: f64) -> f32 {
     let y = round_down_f32(q);
     if rho == 0.0 {
         return y; // exact quotient
-    }
-    let slack = q.abs() * (1.0 / (1u64 << 50) as f64);
-    if round_down_f32(q - slack) == y && round_down_f32(q + slack) == y {
-        return y;
     }
     // Near an `f32` boundary: adjust `y` by exact comparisons with the quotient.
     // `below(y)`: y <= (x - o) / d, i.e. sign(x - o - y d) agrees with sign(d).

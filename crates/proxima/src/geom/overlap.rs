@@ -348,11 +348,7 @@ fn sum4_sign(t: [f64; 4]) -> Option<Ordering> {
     let v = t[0] + t[1] + t[2] + t[3];
     if v.is_finite() {
         let perm: f64 = t.iter().map(|x| x.abs()).sum();
-        return Some(filtered(v, perm).unwrap_or_else(|| {
-            t.iter()
-                .fold(Exp::default(), |e, &x| e.add(&Exp::of(x)))
-                .sign()
-        }));
+        return Some(filtered(v, perm).unwrap_or_else(|| sum_exact(&t)));
     }
     if v.is_nan() {
         return None;
@@ -364,51 +360,75 @@ fn sum4_sign(t: [f64; 4]) -> Option<Ordering> {
     })
 }
 
-/// The exact sign of `D + sign·r|n|` for a plane `(n, dd)` and a sphere `(c, r)`,
-/// where `D = n·c + dd`; `None` for a NaN. `f64` filter (the products are exact,
-/// `√(n·n)` is correctly rounded), then expansions: when `D` and `sign·r|n|`
-/// differ in sign, compare `D²` with `r²|n|²`.
-fn plane_sphere_sign(n: [f64; 3], dd: f64, c: [f64; 3], r: f64, sign: f64) -> Option<Ordering> {
+/// The exact sign of a sum of `f64`s.
+#[cold]
+#[inline(never)]
+fn sum_exact(t: &[f64]) -> Ordering {
+    t.iter()
+        .fold(Exp::default(), |e, &x| e.add(&Exp::of(x)))
+        .sign()
+}
+
+/// The exact signs of `D + r|n|` and `D - r|n|` for a plane `(n, dd)` and a
+/// sphere `(c, r)`, where `D = n·c + dd`; `None` for a NaN. `f64` filter first
+/// (the products are exact, `√(n·n)` is correctly rounded: the error is below
+/// 4u of `Σ|n_i c_i| + |dd| + r|n|`), expansions for near-ties. The inner sign
+/// is only computed when `inner` is set (and the outer one is not negative).
+#[inline]
+fn plane_sphere_signs(
+    n: [f64; 3],
+    dd: f64,
+    c: [f64; 3],
+    r: f64,
+    inner: bool,
+) -> (Option<Ordering>, Option<Ordering>) {
     let terms = [n[0] * c[0], n[1] * c[1], n[2] * c[2], dd];
     let dv = terms[0] + terms[1] + terms[2] + terms[3];
     let n2 = dot(n, n);
     let rn = r * n2.sqrt();
-    let v = dv + sign * rn;
-    if v.is_nan() {
-        return None;
+    if (dv + rn).is_nan() {
+        return (None, None);
     }
-    let perm: f64 = terms.iter().map(|x| x.abs()).sum::<f64>() + rn;
-    if let Some(o) = filtered(v, perm) {
-        return Some(o);
+    let perm = terms[0].abs() + terms[1].abs() + terms[2].abs() + terms[3].abs() + rn;
+    let outer = filtered(dv + rn, perm)
+        .unwrap_or_else(|| plane_sphere_exact(terms, n, r, n2, Ordering::Greater));
+    if !inner || outer == Ordering::Less {
+        return (Some(outer), None);
     }
+    let inside = filtered(dv - rn, perm)
+        .unwrap_or_else(|| plane_sphere_exact(terms, n, r, n2, Ordering::Less));
+    (Some(outer), Some(inside))
+}
+
+/// The exact sign of `Σ terms + rn_sign · r|n|` (`terms` exact products).
+#[cold]
+#[inline(never)]
+fn plane_sphere_exact(terms: [f64; 4], n: [f64; 3], r: f64, n2: f64, sign: Ordering) -> Ordering {
     let de = terms
         .iter()
         .fold(Exp::default(), |e, &x| e.add(&Exp::of(x)));
     let ds = de.sign();
     let rn_sign = if r == 0.0 || n2 == 0.0 {
         Ordering::Equal
-    } else if sign > 0.0 {
-        Ordering::Greater
     } else {
-        Ordering::Less
+        sign
     };
     if ds == rn_sign || rn_sign == Ordering::Equal {
-        return Some(ds);
+        return ds;
     }
     if ds == Ordering::Equal {
-        return Some(rn_sign);
+        return rn_sign;
     }
     // Opposite signs: the larger magnitude wins; compare D² with r²|n|².
     let r = Exp::of(r);
     let nn = n
         .iter()
         .fold(Exp::default(), |e, &x| e.add(&Exp::of(x).mul(&Exp::of(x))));
-    let diff = de.mul(&de).sub(&r.mul(&r).mul(&nn));
-    Some(match diff.sign() {
+    match de.mul(&de).sub(&r.mul(&r).mul(&nn)).sign() {
         Ordering::Greater => ds,
         Ordering::Less => rn_sign,
         Ordering::Equal => Ordering::Equal,
-    })
+    }
 }
 
 /// Frustum–sphere, per plane: `Outside` if the sphere is entirely on the outer
@@ -429,18 +449,11 @@ pub fn frustum_sphere(f: &Frustum, s: &Sphere) -> Relation {
         // `from_view_projection`; 0 for a zero normal (a degenerate matrix: the
         // plane is everywhere inside or everywhere outside), consistent with
         // `frustum_aabb`, whose box extent also scales with |n|.
-        match plane_sphere_sign(n, dd, c, r, 1.0) {
-            Some(Ordering::Less) => return Relation::Outside,
-            None => rel = Relation::Intersecting,
-            _ => {}
-        }
-        if rel == Relation::Inside
-            && !matches!(
-                plane_sphere_sign(n, dd, c, r, -1.0),
-                Some(Ordering::Greater | Ordering::Equal)
-            )
-        {
-            rel = Relation::Intersecting;
+        match plane_sphere_signs(n, dd, c, r, rel == Relation::Inside) {
+            (Some(Ordering::Less), _) => return Relation::Outside,
+            (_, Some(Ordering::Greater | Ordering::Equal)) => {}
+            // Not provably at least `r|n|` inside (or a NaN, which never culls).
+            _ => rel = Relation::Intersecting,
         }
     }
     rel

@@ -556,3 +556,25 @@ fn hash_grid_huge_cell_loose_box() {
     assert_eq!(b.pairs().len(), 1);
     assert_eq!(g.sphere_hits(&big).unwrap().len(), 2);
 }
+
+/// Found by a 10-minute proptest run: with a cell of 2.6e24 an object at
+/// z = -1e30 has a key box padded ~4 cells beyond it on each side (the key
+/// padding is applied twice), and it is reported only from its lowest cell; that
+/// cell's loose box, grown by a single padding, lay beyond the ball of radius
+/// 1e30, so the pair was pruned (a sphere query, with a less padded key box,
+/// found it). Input: `fuzz/found/index_ops-hash-grid-pairs-oversized-far`.
+#[test]
+fn hash_grid_pairs_oversized_far_point() {
+    let big = Sphere::new(vec3(-32.0, 0.0, -32.0), 1e30);
+    let far = Sphere::new(vec3(-32.0, -32.0, -1e30), 0.0);
+    let mut g = HashGrid::with_cell_size(2.6067463e24).unwrap();
+    let mut b = BruteForce::new();
+    for (i, s) in [big, far].into_iter().enumerate() {
+        g.insert(s, i as u32).unwrap();
+        b.insert(s, i as u32).unwrap();
+    }
+    assert_eq!(b.pairs().len(), 1);
+    assert_eq!(g.sphere_hits(&big).unwrap().len(), 2);
+    assert_eq!(g.pairs().len(), 1, "the grid misses the pair");
+    g.validate().unwrap();
+}

@@ -84,3 +84,41 @@ fn replay_extreme_coordinates_all_indices_agree() {
         "pairs 3\nsphere 2\nray 3 2\naabb 2\npairs 2\npairs 0\n"
     );
 }
+
+/// Every command's bad options and values: exit 2 and one line naming the
+/// problem, never a panic; a run that checks and passes exits 0.
+#[test]
+fn bad_options_of_every_command_exit_2_with_one_line() {
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/");
+    let mesh = format!("{data}rob.obj");
+    let mesh = mesh.as_str();
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let poses = dir.join(format!("bad-poses-{}.txt", std::process::id()));
+    std::fs::write(&poses, "1 2 nan\n").unwrap();
+    let poses = poses.to_str().unwrap();
+    let trace = common::write_trace("ok", "insert 1 0 0 0 1\ninsert 2 1 0 0 1\npairs\n");
+    let trace = trace.to_str().unwrap();
+    for args in [
+        vec!["--no-such-flag"],
+        vec!["replay"],
+        vec!["replay", trace, "--index", "no-such-index"],
+        vec!["collide", mesh],
+        vec!["collide", mesh, mesh, "--bv", "cube"],
+        vec!["collide", mesh, mesh, "--split", "nope"],
+        vec!["collide", mesh, mesh, "--leaf", "0"],
+        vec!["collide", mesh, mesh, "--leaf", "-3"],
+        vec!["collide", mesh, mesh, "--rotation", "sideways"],
+        vec!["collide", mesh, mesh, "--poses", "/nonexistent/poses.txt"],
+        vec!["collide", mesh, mesh, "--poses", poses],
+        vec!["collide", mesh, mesh, "--bogus"],
+        vec!["render", "/nonexistent/x.trace"],
+        vec!["demo", "--objects", "many"],
+    ] {
+        let out = proxima(&args);
+        assert_eq!(out.code, 2, "{args:?}: {}", out.stderr);
+        one_clean_line(&out.stderr);
+    }
+    let out = proxima(&["replay", trace, "--index", "all", "--check"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let _ = std::fs::remove_file(poses);
+}

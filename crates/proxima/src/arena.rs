@@ -39,6 +39,24 @@ fn fresh_tag() -> u32 {
 
 const NONE: u32 = u32::MAX;
 
+/// The number of slot indices an arena may use: `0..NONE`. Tests lower it per
+/// thread to reach the limit cheaply (`arena::tests::capacity`).
+#[cfg(not(test))]
+#[inline]
+fn slot_limit() -> usize {
+    NONE as usize
+}
+
+#[cfg(test)]
+thread_local! {
+    static TEST_SLOT_LIMIT: std::cell::Cell<usize> = const { std::cell::Cell::new(NONE as usize) };
+}
+
+#[cfg(test)]
+fn slot_limit() -> usize {
+    TEST_SLOT_LIMIT.with(|c| c.get())
+}
+
 #[derive(Clone, Debug)]
 enum Entry<V> {
     Occupied(V),
@@ -112,8 +130,26 @@ impl<V> Arena<V> {
         }
     }
 
-    /// Stores `value` and returns its handle. O(1) amortized.
-    pub fn insert(&mut self, value: V) -> Handle {
+    /// Fails with [`Error::CapacityExceeded`] when the next `insert` would: no
+    /// free slot and all 2^32 - 1 slot indices in use (`u32::MAX` marks the end of
+    /// the free list). Indices call it before changing anything, so a full index
+    /// is left exactly as it was. O(1).
+    pub fn check_room(&self) -> Result<()> {
+        let limit = slot_limit();
+        if self.free_head == NONE && self.slots.len() >= limit {
+            return Err(Error::CapacityExceeded {
+                what: "object slots",
+                limit,
+            });
+        }
+        Ok(())
+    }
+
+    /// Stores `value` and returns its handle, or fails with
+    /// [`Error::CapacityExceeded`] (see [`Arena::check_room`]), storing nothing.
+    /// O(1) amortized.
+    pub fn insert(&mut self, value: V) -> Result<Handle> {
+        self.check_room()?;
         let h = self.next_handle();
         if self.free_head != NONE {
             let slot = &mut self.slots[self.free_head as usize];
@@ -123,14 +159,13 @@ impl<V> Arena<V> {
             self.free_head = next_free;
             slot.entry = Entry::Occupied(value);
         } else {
-            assert!(self.slots.len() < NONE as usize, "arena full");
             self.slots.push(Slot {
                 generation: 0,
                 entry: Entry::Occupied(value),
             });
         }
         self.len += 1;
-        h
+        Ok(h)
     }
 
     fn slot_of(&self, h: Handle) -> Result<usize> {
@@ -379,28 +414,95 @@ mod tests {
     fn stale_and_foreign_handles_are_rejected() {
         let mut a = Arena::new();
         let mut b: Arena<i32> = Arena::new();
-        let h1 = a.insert(1);
+        let h1 = a.insert(1).unwrap();
         assert_eq!(b.get(h1), Err(Error::StaleHandle));
         assert_eq!(a.remove(h1), Ok(1));
         assert_eq!(a.get(h1), Err(Error::StaleHandle));
-        let h2 = a.insert(2);
+        let h2 = a.insert(2).unwrap();
         assert_eq!(h2.index(), h1.index(), "slot is reused");
         assert_eq!(a.get(h1), Err(Error::StaleHandle));
         assert_eq!(a.get(h2), Ok(&2));
         a.clear();
         assert_eq!(a.get(h2), Err(Error::StaleHandle));
-        let h3 = a.insert(3);
+        let h3 = a.insert(3).unwrap();
         assert_eq!(h3.index(), 0);
         assert_eq!(a.get(h2), Err(Error::StaleHandle));
         a.validate().unwrap();
-        b.insert(5);
+        b.insert(5).unwrap();
         b.validate().unwrap();
+    }
+
+    /// With the slot limit lowered (for this test thread only), the insert past
+    /// it fails with `CapacityExceeded` on the arena and on every index, which is
+    /// left exactly as it was; a removal makes room again.
+    #[test]
+    fn capacity() {
+        use crate::broad::{
+            BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex,
+            UniformGrid2d, UniformGrid3d,
+        };
+        use crate::geom::{Aabb, Sphere};
+        use glam::{vec3, Vec3};
+
+        fn check<I: SpatialIndex<u32>>(mut i: I) {
+            let spheres = [
+                Sphere::new(vec3(1.0, 2.0, 3.0), 1.0),
+                Sphere::new(vec3(2.0, 2.0, 3.0), 0.5),
+                Sphere::new(vec3(90.0, 2.0, 3.0), 3.0),
+            ];
+            let hs: Vec<Handle> = spheres
+                .iter()
+                .enumerate()
+                .map(|(k, s)| i.insert(*s, k as u32).unwrap())
+                .collect();
+            let snapshot = |i: &I| {
+                let mut all = Vec::new();
+                i.for_each(|h, s, v| all.push((h, *s, *v)));
+                (all, i.pairs(), i.memory_bytes(), i.len())
+            };
+            let before = snapshot(&i);
+            // Far away, huge, tiny: whatever the index would do with it, it must not.
+            for s in [
+                Sphere::new(Vec3::splat(1e30), 5.0),
+                Sphere::new(Vec3::ZERO, 1e20),
+                Sphere::new(vec3(1.5, 2.0, 3.0), 0.0),
+            ] {
+                let full = Error::CapacityExceeded {
+                    what: "object slots",
+                    limit: 3,
+                };
+                assert_eq!(i.insert(s, 9), Err(full));
+                assert_eq!(snapshot(&i), before);
+                i.validate().unwrap();
+            }
+            assert_eq!(i.remove(hs[1]), Ok(1));
+            let h = i.insert(spheres[1], 7).unwrap();
+            assert_eq!(h.index(), hs[1].index(), "the freed slot is reused");
+            i.validate().unwrap();
+        }
+
+        TEST_SLOT_LIMIT.with(|c| c.set(3));
+        let mut a = Arena::new();
+        for k in 0..3 {
+            a.insert(k).unwrap();
+        }
+        assert!(matches!(a.insert(3), Err(Error::CapacityExceeded { .. })));
+        assert_eq!((a.len(), a.slot_count()), (3, 3));
+        a.validate().unwrap();
+        let world = Aabb::new(Vec3::ZERO, Vec3::splat(100.0));
+        check(BruteForce::new());
+        check(LooseKdTree::new(world, 2.0, 0.5).unwrap());
+        check(LinearOctree::new(world, OctreeConfig::default()).unwrap());
+        check(UniformGrid2d::new(world, 2.0).unwrap());
+        check(HashGrid::new(2.0).unwrap());
+        check(UniformGrid3d::new(world, 2.0).unwrap());
+        TEST_SLOT_LIMIT.with(|c| c.set(NONE as usize));
     }
 
     #[test]
     fn by_index_access() {
         let mut a = Arena::new();
-        let h = a.insert(5);
+        let h = a.insert(5).unwrap();
         assert_eq!(a.get_by_index(h.index()), Some((h, &5)));
         *a.get_by_index_mut(h.index()).unwrap() = 6;
         a.remove(h).unwrap();
@@ -412,14 +514,14 @@ mod tests {
     #[test]
     fn generation_wrap_retires_slot() {
         let mut a = Arena::new();
-        let h = a.insert(0u8);
+        let h = a.insert(0u8).unwrap();
         a.slots[0].generation = u32::MAX;
         let h = Handle {
             generation: u32::MAX,
             ..h
         };
         a.remove(h).unwrap();
-        let h2 = a.insert(1);
+        let h2 = a.insert(1).unwrap();
         assert_ne!(h2.index(), 0, "wrapped slot must not be reused");
         a.validate().unwrap();
     }

@@ -36,6 +36,24 @@ pub enum Error {
     /// A pose that is not a rigid motion: non-finite, or a matrix that is not a
     /// rotation (orthonormal with determinant +1, within a small tolerance).
     InvalidPose(String),
+    /// An index into a collection was out of range (for example a triangle index
+    /// of a [`TriMesh`](crate::narrow::TriMesh)).
+    IndexOutOfRange {
+        /// What was indexed (for example `"triangle"`).
+        what: &'static str,
+        /// The index given.
+        index: usize,
+        /// The number of elements.
+        len: usize,
+    },
+    /// A structure is full: every handle slot (2^32 - 1 per index) is in use. The
+    /// insert that failed changed nothing.
+    CapacityExceeded {
+        /// What is full (for example `"object slots"`).
+        what: &'static str,
+        /// The limit that was reached.
+        limit: usize,
+    },
     /// A mesh file could not be read (I/O failure, unknown format).
     Io {
         /// The file's path as given.
@@ -91,6 +109,12 @@ impl fmt::Display for Error {
             Error::Invalid(msg) => write!(f, "invariant violated: {msg}"),
             Error::InvalidMesh(msg) => write!(f, "invalid mesh: {msg}"),
             Error::InvalidPose(msg) => write!(f, "invalid pose: {msg}"),
+            Error::IndexOutOfRange { what, index, len } => {
+                write!(f, "{what} index {index} out of range (there are {len})")
+            }
+            Error::CapacityExceeded { what, limit } => {
+                write!(f, "capacity exceeded: all {limit} {what} are in use")
+            }
             Error::Io { file, msg } => write!(f, "{file}: {msg}"),
             Error::Parse { file, at, msg } => write!(f, "{file}: {at}: {msg}"),
         }

@@ -6,7 +6,7 @@
 
 use proxima::broad::{
     BruteForce, Handle, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex,
-    UniformGrid2d,
+    UniformGrid2d, UniformGrid3d,
 };
 use proxima::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};
 use proxima::glam::{vec3, Mat4, Vec3};
@@ -42,6 +42,10 @@ macro_rules! per_index {
             #[test]
             fn hash_grid() {
                 super::$body(&|| HashGrid::new(2.0).unwrap());
+            }
+            #[test]
+            fn grid3d() {
+                super::$body(&|| UniformGrid3d::new(world(), 2.0).unwrap());
             }
         }
     };
@@ -535,4 +539,46 @@ fn hash_grid_empty_strip_range() {
     assert_eq!(g.ray_hits(&r).unwrap().len(), b.ray_hits(&r).unwrap().len());
     let r = Ray::with_max_t(vec3(-1e12, 0.0, 0.0), vec3(1.0, 0.0, 0.0), 2e12);
     assert_eq!(g.ray_hits(&r).unwrap().len(), b.ray_hits(&r).unwrap().len());
+}
+
+/// Found by the proptest op sequences once far rays were compared: with a cell of
+/// 3e38 the hash grid's loose box of cell y = -2 was `[-∞, -∞]` (its upper side
+/// computed as `min + cell` from an overflowed `min`), so a query with a ball of
+/// radius `f32::MAX` pruned the cell holding an object at y = -3e38.
+#[test]
+fn hash_grid_huge_cell_loose_box() {
+    let big = Sphere::new(vec3(25.25, -21.5, -15.75), f32::MAX);
+    let far = Sphere::new(vec3(-4.25, -3e38, 4352.0), 18.875);
+    let mut g = HashGrid::with_cell_size(3e38).unwrap();
+    let mut b = BruteForce::new();
+    for (i, s) in [big, far].into_iter().enumerate() {
+        g.insert(s, i as u32).unwrap();
+        b.insert(s, i as u32).unwrap();
+    }
+    g.validate().unwrap();
+    assert_eq!(g.pairs().len(), 1);
+    assert_eq!(b.pairs().len(), 1);
+    assert_eq!(g.sphere_hits(&big).unwrap().len(), 2);
+}
+
+/// Found by a 10-minute proptest run: with a cell of 2.6e24 an object at
+/// z = -1e30 has a key box padded ~4 cells beyond it on each side (the key
+/// padding is applied twice), and it is reported only from its lowest cell; that
+/// cell's loose box, grown by a single padding, lay beyond the ball of radius
+/// 1e30, so the pair was pruned (a sphere query, with a less padded key box,
+/// found it). Input: `fuzz/found/index_ops-hash-grid-pairs-oversized-far`.
+#[test]
+fn hash_grid_pairs_oversized_far_point() {
+    let big = Sphere::new(vec3(-32.0, 0.0, -32.0), 1e30);
+    let far = Sphere::new(vec3(-32.0, -32.0, -1e30), 0.0);
+    let mut g = HashGrid::with_cell_size(2.6067463e24).unwrap();
+    let mut b = BruteForce::new();
+    for (i, s) in [big, far].into_iter().enumerate() {
+        g.insert(s, i as u32).unwrap();
+        b.insert(s, i as u32).unwrap();
+    }
+    assert_eq!(b.pairs().len(), 1);
+    assert_eq!(g.sphere_hits(&big).unwrap().len(), 2);
+    assert_eq!(g.pairs().len(), 1, "the grid misses the pair");
+    g.validate().unwrap();
 }

@@ -35,7 +35,7 @@ impl<T> BruteForce<T> {
 impl<T: Send + Sync> SpatialIndex<T> for BruteForce<T> {
     fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         sphere.validate()?;
-        Ok(self.items.insert((sphere, value)))
+        self.items.insert((sphere, value))
     }
 
     fn remove(&mut self, handle: Handle) -> Result<T> {

@@ -3,16 +3,19 @@
 //!
 //! Closed means boundaries count: touching shapes overlap. Costs are O(1).
 
+use crate::geom::exact::Exp;
 use crate::geom::{Aabb, Frustum, Ray, Relation, Sphere};
 use glam::{Vec3, Vec4};
+use std::cmp::Ordering;
 
 // The sphere tests are exact: whether `|p - q| <= r1 + r2` is decided for the
 // real numbers the `f32` inputs denote, at every magnitude. A fast `f64`
 // evaluation decides unless the two sides agree to 1e-12 relative; then an exact
 // evaluation (error-free transformations, see `exact.rs`) decides. In `f64` no
 // square of a finite `f32` overflows (x² <= 1.2e77), so there is no `inf <= inf`.
-// The other tests (rays, frustums) compute in `f64`: no overflow for finite
-// inputs, rounding ~1e-16 relative.
+// The ray and frustum tests are exact too (hit/miss, cull/keep), by the same
+// filter-then-expansion scheme; only the returned ray parameters are rounded,
+// and those outward where pruning depends on them.
 
 #[inline]
 fn d3(v: Vec3) -> [f64; 3] {
@@ -126,50 +129,227 @@ pub fn aabb_aabb(a: &Aabb, b: &Aabb) -> bool {
     a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
 }
 
-/// Ray (or segment) against a sphere: the smallest `t` in `[0, ray.max_t]` at which
-/// the ray is in the closed ball, or `None`. An origin inside the ball gives `0`.
+/// Relative error bound for the `f64` filters of the ray and frustum tests: every
+/// filtered quantity is a polynomial of degree <= 4 in `f32` inputs, evaluated
+/// with a handful of roundings of 2^-53 each, whose error is below ~16 · 2^-53 of
+/// its permanent (the same polynomial on absolute values). 1e-14 is 9× that.
+const FILTER: f64 = 1e-14;
+
+/// The sign of a value computed in `f64` as `v` with permanent `perm`, if the
+/// filter decides it; `None` sends the caller to the exact evaluation.
+#[inline]
+fn filtered(v: f64, perm: f64) -> Option<Ordering> {
+    let margin = FILTER * perm;
+    if v > margin {
+        Some(Ordering::Greater)
+    } else if v < -margin {
+        Some(Ordering::Less)
+    } else {
+        None
+    }
+}
+
+/// The unit roundoff of `f64`, 2^-53.
+const U: f64 = f64::EPSILON / 2.0;
+
+/// The sign of `lhs - |v|²`, if an `f64` evaluation decides it: `lhs` within
+/// 4u of its value (a product of up to three rounded factors), each `v[k]`
+/// within `err[k]` of its value. An a-posteriori bound (from the computed `v`,
+/// not from the inputs' magnitudes), so a long ray passing near a small sphere
+/// (huge inputs, modest cross product) still decides in `f64`; the bound is
+/// doubled to cover its own rounding.
+#[inline]
+fn square_gap(lhs: f64, v: [f64; 3], err: [f64; 3]) -> Option<Ordering> {
+    let vv = dot(v, v);
+    let mut bound = 4.0 * U * (lhs + vv);
+    for k in 0..3 {
+        bound += (2.0 * v[k].abs() + err[k]) * err[k];
+    }
+    filtered(lhs - vv, 2.0 * bound / FILTER)
+}
+
+#[inline]
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Ray (or segment) against a sphere: a parameter `t` in `[0, ray.max_t]` at which
+/// the ray is (up to rounding) entering the closed ball, or `None` when no point
+/// of the ray within `[0, max_t]` is in the ball.
 ///
-/// Uses the closest-approach form (distance of the centre from the line computed
-/// from the projected point, not from `b² - ac`) to avoid cancellation for long
-/// rays, in `f64`; the returned `t` is that value rounded to `f32`, and it is that
-/// rounded value which is compared with `max_t`.
+/// Hit or miss is decided **exactly** for the real numbers the `f32` inputs
+/// denote, at every magnitude: with `m = o - c`, the distance `|m + t d|` is
+/// convex in `t`, so the ray meets the ball iff the origin is in it (exact
+/// `within`), or it approaches (`m·d < 0`) and either the closest approach lies
+/// within `max_t` and `|m × d|² <= r²|d|²`, or it lies beyond and the end point is
+/// in the ball (`|m + max_t d|² <= r²`). Each sign is first taken from an `f64`
+/// evaluation with an error bound (cost: ~40 flops) and only for near-ties
+/// from error-free expansions (`exact.rs`).
+///
+/// The returned `t` is the closest-approach formula in `f64` (no `b² - ac`
+/// cancellation), rounded to `f32`, then clamped into `[lb, max_t]` where `lb` is
+/// [`ray_aabb`]'s rigorous lower bound for entering the sphere's bounding box.
+/// Since `ray_aabb`'s entry bound is monotone in the box, an index box containing
+/// the sphere never has an entry bound above this `t`, so front-to-back pruning
+/// (`box t0 > best t`) never drops a nearer hit.
 #[inline]
 pub fn ray_sphere(ray: &Ray, s: &Sphere) -> Option<f32> {
-    let (o, c, d) = (d3(ray.origin), d3(s.center), d3(ray.dir));
-    let m = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let r = s.radius as f64;
-    let r2 = r * r;
     if within(ray.origin, s.center, s.radius, 0.0) {
         return Some(0.0);
     }
-    let b = dot(m, d);
-    if b >= 0.0 {
+    let (o, c, d) = (d3(ray.origin), d3(s.center), d3(ray.dir));
+    let m = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
+    let r = s.radius as f64;
+    let (b, b_perm) = (dot(m, d), dot(m.map(f64::abs), d.map(f64::abs)));
+    let approaching = filtered(b, b_perm).unwrap_or_else(|| ray_exact::m_dot_d(ray, s));
+    if approaching != Ordering::Less {
         // Outside and not approaching: the distance only grows with t.
         return None;
     }
     let a = dot(d, d);
-    let tc = -b / a;
-    let closest = [m[0] + d[0] * tc, m[1] + d[1] * tc, m[2] + d[2] * tc];
-    let h2 = r2 - dot(closest, closest);
-    if h2 < 0.0 {
+    let big_t = ray.max_t as f64;
+    // Closest approach `t* = -b / a` within `max_t`: sign of `max_t·a + b`.
+    let closest_within = big_t.is_infinite()
+        || filtered(big_t * a + b, big_t * a + b_perm)
+            .unwrap_or_else(|| ray_exact::end_minus_closest(ray, s))
+            != Ordering::Less;
+    let hit = if closest_within {
+        // r²|d|² - |m × d|² >= 0, with m × d = o × d - c × d: the products of
+        // `f32`s are exact in `f64`, so each component rounds only three times,
+        // relative to values that do not include the huge cancelling parts of
+        // `m` (a ray from 1e20 passing 100 units from a sphere still decides).
+        let cross = |p: [f64; 3]| {
+            [
+                p[1] * d[2] - p[2] * d[1],
+                p[2] * d[0] - p[0] * d[2],
+                p[0] * d[1] - p[1] * d[0],
+            ]
+        };
+        let (ox, cx) = (cross(o), cross(c));
+        let cr = [0, 1, 2].map(|k| ox[k] - cx[k]);
+        let err = [0, 1, 2].map(|k| 2.0 * U * (ox[k].abs() + cx[k].abs() + cr[k].abs()));
+        square_gap(r * r * a, cr, err).unwrap_or_else(|| ray_exact::line_gap(ray, s))
+            != Ordering::Less
+    } else {
+        // r² - |o + max_t d - c|² >= 0 (`max_t d` is exact: two `f32`s), two
+        // roundings per component, bounded by the computed values.
+        let e = [0, 1, 2].map(|i| o[i] + big_t * d[i]);
+        let p = [0, 1, 2].map(|i| e[i] - c[i]);
+        let err = [0, 1, 2].map(|i| 2.0 * U * (e[i].abs() + p[i].abs()));
+        square_gap(r * r, p, err).unwrap_or_else(|| ray_exact::end_gap(ray, s)) != Ordering::Less
+    };
+    if !hit {
         return None;
     }
-    let t = ((tc - (h2 / a).sqrt()).max(0.0)) as f32;
-    (t <= ray.max_t).then_some(t)
+    let tc = -b / a;
+    let closest = [m[0] + d[0] * tc, m[1] + d[1] * tc, m[2] + d[2] * tc];
+    let h2 = (r * r - dot(closest, closest)).max(0.0);
+    let t = (tc - (h2 / a).sqrt()).max(0.0) as f32;
+    // The sphere's bounding box, rounded outward to `f32`: every index box that
+    // contains the sphere contains it.
+    let lb = ray_aabb(ray, &outward_box(s)).map_or(0.0, |(t0, _)| t0);
+    Some(t.max(lb).min(ray.max_t))
 }
 
-/// Ray (or segment) against a box: the parameter interval `[t_enter, t_exit]` of the
-/// ray inside the closed box, clipped to `[0, ray.max_t]`, or `None`.
+/// The smallest `f32` box containing the ball exactly.
+#[inline]
+fn outward_box(s: &Sphere) -> Aabb {
+    let r = s.radius as f64;
+    let c = d3(s.center);
+    let lo = [0, 1, 2].map(|i| {
+        let (v, e) = super::exact::two_sum_pub(c[i], -r);
+        // `round_down(v)` is at least one `f64` step below `v` unless `v` is an
+        // `f32`; only then can the error `e` push the true value below it.
+        if e < 0.0 && (v as f32) as f64 == v {
+            step_down(v as f32)
+        } else {
+            round_down(v)
+        }
+    });
+    let hi = [0, 1, 2].map(|i| {
+        let (v, e) = super::exact::two_sum_pub(c[i], r);
+        if e > 0.0 && (v as f32) as f64 == v {
+            -step_down(-(v as f32))
+        } else {
+            round_up(v)
+        }
+    });
+    Aabb::new(Vec3::from(lo), Vec3::from(hi))
+}
+
+/// The exact fallbacks of [`ray_sphere`], one per filtered sign.
+mod ray_exact {
+    use super::d3;
+    use crate::geom::exact::Exp;
+    use crate::geom::{Ray, Sphere};
+    use std::cmp::Ordering;
+
+    fn parts(ray: &Ray, s: &Sphere) -> ([Exp; 3], [f64; 3]) {
+        let (o, c) = (d3(ray.origin), d3(s.center));
+        ([0, 1, 2].map(|i| Exp::diff(o[i], c[i])), d3(ray.dir))
+    }
+
+    fn dot(a: &[Exp; 3], b: &[Exp; 3]) -> Exp {
+        a[0].mul(&b[0]).add(&a[1].mul(&b[1])).add(&a[2].mul(&b[2]))
+    }
+
+    /// Sign of `m · d`.
+    pub(super) fn m_dot_d(ray: &Ray, s: &Sphere) -> Ordering {
+        let (m, d) = parts(ray, s);
+        dot(&m, &d.map(Exp::of)).sign()
+    }
+
+    /// Sign of `max_t |d|² + m · d`.
+    pub(super) fn end_minus_closest(ray: &Ray, s: &Sphere) -> Ordering {
+        let (m, d) = parts(ray, s);
+        let d = d.map(Exp::of);
+        Exp::of(ray.max_t as f64)
+            .mul(&dot(&d, &d))
+            .add(&dot(&m, &d))
+            .sign()
+    }
+
+    /// Sign of `r² |d|² - |m × d|²`.
+    pub(super) fn line_gap(ray: &Ray, s: &Sphere) -> Ordering {
+        let (m, d) = parts(ray, s);
+        let d = d.map(Exp::of);
+        let cr = [
+            m[1].mul(&d[2]).sub(&m[2].mul(&d[1])),
+            m[2].mul(&d[0]).sub(&m[0].mul(&d[2])),
+            m[0].mul(&d[1]).sub(&m[1].mul(&d[0])),
+        ];
+        let r = Exp::of(s.radius as f64);
+        r.mul(&r).mul(&dot(&d, &d)).sub(&dot(&cr, &cr)).sign()
+    }
+
+    /// Sign of `r² - |m + max_t d|²`.
+    pub(super) fn end_gap(ray: &Ray, s: &Sphere) -> Ordering {
+        let (m, d) = parts(ray, s);
+        let t = Exp::of(ray.max_t as f64);
+        let p = [0, 1, 2].map(|i| m[i].add(&t.mul(&Exp::of(d[i]))));
+        let r = Exp::of(s.radius as f64);
+        r.mul(&r).sub(&dot(&p, &p)).sign()
+    }
+}
+
+/// Ray (or segment) against a box: the interval `[t0, t1]` of `f32`s that
+/// rounds the exact parameter interval of the ray inside the closed box outward
+/// (`t0` the largest `f32` not above the exact entry, `t1` the smallest not below
+/// the exact exit), clipped to `[0, ray.max_t]`; `None` only when the exact
+/// interval is empty.
 ///
-/// A zero direction component is handled explicitly (the ray is inside that slab for
-/// all `t` or for none), so no `0 * ∞` NaN arises. Computed in `f64` (a tiny
-/// direction component gives a huge but finite inverse); the interval is rounded
-/// outward to `f32`, so it always contains the exact one.
+/// So the test never rejects a box the ray meets, at any magnitude, and `t0` is
+/// monotone in the box (a larger box never gets a larger `t0`), which makes
+/// front-to-back pruning consistent with [`ray_sphere`]. Each slab's parameters
+/// `(lo - o) / d` come from `exact::quotient_floor_f32`: an `f64` division whose
+/// exact residual (one FMA) shows when it is exact, an exact adjustment only when
+/// it lies within 2^-50 of an `f32` boundary. A zero direction component is
+/// handled explicitly (inside the slab for all `t` or none), so no `0 * ∞` NaN
+/// arises. Cost: 6 divisions and 6 FMAs in the common case.
 #[inline]
 pub fn ray_aabb(ray: &Ray, b: &Aabb) -> Option<(f32, f32)> {
-    let mut t0 = 0.0f64;
-    let mut t1 = ray.max_t as f64;
+    let mut t0 = 0.0f32;
+    let mut t1 = ray.max_t;
     for axis in 0..3 {
         let o = ray.origin[axis] as f64;
         let d = ray.dir[axis] as f64;
@@ -180,85 +360,153 @@ pub fn ray_aabb(ray: &Ray, b: &Aabb) -> Option<(f32, f32)> {
             }
             continue;
         }
-        let inv = 1.0 / d;
-        let (mut ta, mut tb) = ((lo - o) * inv, (hi - o) * inv);
-        if ta > tb {
-            std::mem::swap(&mut ta, &mut tb);
-        }
+        // The entry side rounds down, the exit side up (`⌈q⌉ = -⌊-q⌋`).
+        let floor = |x: f64, o: f64| {
+            if x.is_finite() {
+                super::exact::quotient_floor_f32(x, o, d)
+            } else {
+                // An infinite side (loose bounds of huge objects): exact ±∞.
+                ((x - o) / d) as f32
+            }
+        };
+        let (near, far) = if d > 0.0 { (lo, hi) } else { (hi, lo) };
+        let enter = floor(near, o);
+        let exit = -floor(-far, -o);
         // `max`/`min` ignore a NaN operand (a NaN box), which keeps the test
         // conservative.
-        t0 = t0.max(ta);
-        t1 = t1.min(tb);
+        t0 = t0.max(enter);
+        t1 = t1.min(exit);
         if t0 > t1 {
             return None;
         }
     }
-    Some((round_down(t0), round_up(t1)))
+    Some((t0, t1))
 }
 
-/// The largest `f32` not above `x`.
-#[inline]
-fn round_down(x: f64) -> f32 {
-    let y = x as f32;
-    if (y as f64) > x {
-        step_down(y)
-    } else {
-        y
-    }
-}
-
-/// The next `f32` toward −∞ (`f32::next_down` needs Rust 1.86; the MSRV is 1.80).
-#[inline]
-fn step_down(y: f32) -> f32 {
-    if y.is_nan() || y == f32::NEG_INFINITY {
-        y
-    } else if y == 0.0 {
-        -f32::from_bits(1)
-    } else if y > 0.0 {
-        f32::from_bits(y.to_bits() - 1)
-    } else {
-        f32::from_bits(y.to_bits() + 1)
-    }
-}
+use super::exact::{f32_down as step_down, round_down_f32 as round_down};
 
 /// The smallest `f32` not below `x`.
 #[inline]
 fn round_up(x: f64) -> f32 {
-    let y = x as f32;
-    if (y as f64) < x {
-        -step_down(-y)
+    -round_down(-x)
+}
+
+/// The exact sign of `t[0] + t[1] + t[2] + t[3]` for `f64` terms that are exact
+/// products of `f32`s (or `f32`s), or `None` when it is undefined (a NaN, or
+/// infinities of both signs). Infinite terms (boxes with infinite sides) decide
+/// by their sign. `f64` filter first: the terms are exact, the sum rounds three
+/// times (error <= 3 · 2^-53 of the sum of magnitudes).
+#[inline]
+fn sum4_sign(t: [f64; 4]) -> Option<Ordering> {
+    let v = t[0] + t[1] + t[2] + t[3];
+    if v.is_finite() {
+        let perm: f64 = t.iter().map(|x| x.abs()).sum();
+        return Some(filtered(v, perm).unwrap_or_else(|| sum_exact(&t)));
+    }
+    if v.is_nan() {
+        return None;
+    }
+    Some(if v > 0.0 {
+        Ordering::Greater
     } else {
-        y
+        Ordering::Less
+    })
+}
+
+/// The exact sign of a sum of `f64`s.
+#[cold]
+#[inline(never)]
+fn sum_exact(t: &[f64]) -> Ordering {
+    t.iter()
+        .fold(Exp::default(), |e, &x| e.add(&Exp::of(x)))
+        .sign()
+}
+
+/// The exact signs of `D + r|n|` and `D - r|n|` for a plane `(n, dd)` and a
+/// sphere `(c, r)`, where `D = n·c + dd`; `None` for a NaN. `f64` filter first
+/// (the products are exact, `√(n·n)` is correctly rounded: the error is below
+/// 4u of `Σ|n_i c_i| + |dd| + r|n|`), expansions for near-ties. The inner sign
+/// is only computed when `inner` is set (and the outer one is not negative).
+#[inline]
+fn plane_sphere_signs(
+    n: [f64; 3],
+    dd: f64,
+    c: [f64; 3],
+    r: f64,
+    inner: bool,
+) -> (Option<Ordering>, Option<Ordering>) {
+    let terms = [n[0] * c[0], n[1] * c[1], n[2] * c[2], dd];
+    let dv = terms[0] + terms[1] + terms[2] + terms[3];
+    let n2 = dot(n, n);
+    let rn = r * n2.sqrt();
+    if (dv + rn).is_nan() {
+        return (None, None);
+    }
+    let perm = terms[0].abs() + terms[1].abs() + terms[2].abs() + terms[3].abs() + rn;
+    let outer = filtered(dv + rn, perm)
+        .unwrap_or_else(|| plane_sphere_exact(terms, n, r, n2, Ordering::Greater));
+    if !inner || outer == Ordering::Less {
+        return (Some(outer), None);
+    }
+    let inside = filtered(dv - rn, perm)
+        .unwrap_or_else(|| plane_sphere_exact(terms, n, r, n2, Ordering::Less));
+    (Some(outer), Some(inside))
+}
+
+/// The exact sign of `Σ terms + rn_sign · r|n|` (`terms` exact products).
+#[cold]
+#[inline(never)]
+fn plane_sphere_exact(terms: [f64; 4], n: [f64; 3], r: f64, n2: f64, sign: Ordering) -> Ordering {
+    let de = terms
+        .iter()
+        .fold(Exp::default(), |e, &x| e.add(&Exp::of(x)));
+    let ds = de.sign();
+    let rn_sign = if r == 0.0 || n2 == 0.0 {
+        Ordering::Equal
+    } else {
+        sign
+    };
+    if ds == rn_sign || rn_sign == Ordering::Equal {
+        return ds;
+    }
+    if ds == Ordering::Equal {
+        return rn_sign;
+    }
+    // Opposite signs: the larger magnitude wins; compare D² with r²|n|².
+    let r = Exp::of(r);
+    let nn = n
+        .iter()
+        .fold(Exp::default(), |e, &x| e.add(&Exp::of(x).mul(&Exp::of(x))));
+    match de.mul(&de).sub(&r.mul(&r).mul(&nn)).sign() {
+        Ordering::Greater => ds,
+        Ordering::Less => rn_sign,
+        Ordering::Equal => Ordering::Equal,
     }
 }
 
-#[inline]
-fn signed_distance(p: &crate::geom::Plane, c: [f64; 3]) -> f64 {
-    let n = d3(p.normal);
-    n[0] * c[0] + n[1] * c[1] + n[2] * c[2] + p.d as f64
-}
-
-/// Frustum–sphere, per plane: `Outside` if the sphere is entirely on the outer side of
-/// some plane (`n·c + d < -r |n|`; `|n| = 1` for normalized planes), `Inside` if it is at least `r` inside every plane,
-/// else `Intersecting`. A sphere exactly touching a plane from outside is not culled.
-/// In `f64`; a NaN distance (only from a NaN plane) never culls.
+/// Frustum–sphere, per plane: `Outside` if the sphere is entirely on the outer
+/// side of some plane (`n·c + d < -r |n|`; `|n| = 1` for normalized planes),
+/// `Inside` if it is at least `r |n|` inside every plane (`n·c + d >= r |n|`),
+/// else `Intersecting`. A sphere exactly touching a plane from outside is not
+/// culled. Decided **exactly** for the `f32` inputs (f64 filter, expansions for
+/// near-ties), so it agrees with [`frustum_aabb`] on every box containing the
+/// sphere at any magnitude. A NaN (only from a NaN plane) never culls.
 #[inline]
 pub fn frustum_sphere(f: &Frustum, s: &Sphere) -> Relation {
     let mut rel = Relation::Inside;
     let c = d3(s.center);
+    let r = s.radius as f64;
     for p in &f.planes {
-        let d = signed_distance(p, c);
-        // The radius in the plane's units: `r |n|`. For the unit normals of
-        // `from_view_projection` this is `r`; for a zero normal (a degenerate
-        // matrix: the plane is everywhere inside or everywhere outside) it is 0,
-        // consistent with `frustum_aabb`, whose box extent also scales with |n|.
-        let n = d3(p.normal);
-        let r = s.radius as f64 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        if d < -r {
-            return Relation::Outside;
-        }
-        if d < r || d.is_nan() {
-            rel = Relation::Intersecting;
+        let (n, dd) = (d3(p.normal), p.d as f64);
+        // The radius in the plane's units is `r |n|`: `r` for the unit normals of
+        // `from_view_projection`; 0 for a zero normal (a degenerate matrix: the
+        // plane is everywhere inside or everywhere outside), consistent with
+        // `frustum_aabb`, whose box extent also scales with |n|.
+        match plane_sphere_signs(n, dd, c, r, rel == Relation::Inside) {
+            (Some(Ordering::Less), _) => return Relation::Outside,
+            (_, Some(Ordering::Greater | Ordering::Equal)) => {}
+            // Not provably at least `r|n|` inside (or a NaN, which never culls).
+            _ => rel = Relation::Intersecting,
         }
     }
     rel
@@ -271,26 +519,42 @@ pub fn frustum_sphere(f: &Frustum, s: &Sphere) -> Relation {
 /// only against the returned mask (plane masking). `Inside` when the returned mask
 /// is empty. A box that merely touches a plane from outside is not culled.
 ///
-/// In `f64`, and conservative for boxes with infinite sides (loose bounds of huge
-/// objects): a NaN distance neither culls nor proves a plane contains the box.
+/// Exact: a plane culls the box iff `n·p + d < 0` at the box corner farthest
+/// along `n` (the "p-vertex"), and contains it iff `n·p + d >= 0` at the nearest
+/// corner; both sums of four exact `f64` products, signed by an `f64` filter or
+/// an expansion. Boxes with infinite sides (loose bounds of huge objects) are
+/// handled by the infinite terms' sign; a NaN or `∞ - ∞` neither culls nor
+/// proves a plane contains the box.
 #[inline]
 pub fn frustum_aabb(f: &Frustum, b: &Aabb, mask: u8) -> (Relation, u8) {
     let (lo, hi) = (d3(b.min), d3(b.max));
-    let c = [0, 1, 2].map(|i| lo[i] * 0.5 + hi[i] * 0.5);
-    let h = [0, 1, 2].map(|i| hi[i] * 0.5 - lo[i] * 0.5);
     let mut out_mask = 0u8;
     for (i, p) in f.planes.iter().enumerate() {
         let bit = 1u8 << i;
         if mask & bit == 0 {
             continue;
         }
-        let s = signed_distance(p, c);
-        let n = d3(p.normal.abs());
-        let e = n[0] * h[0] + n[1] * h[1] + n[2] * h[2];
-        if s + e < 0.0 {
+        let n = d3(p.normal);
+        // A zero normal component contributes 0 whatever the box (no 0 · ∞).
+        let term = |k: usize, pick_hi: bool| {
+            if n[k] == 0.0 {
+                0.0
+            } else if pick_hi {
+                n[k] * hi[k]
+            } else {
+                n[k] * lo[k]
+            }
+        };
+        let far = [0, 1, 2].map(|k| term(k, n[k] > 0.0));
+        let near = [0, 1, 2].map(|k| term(k, n[k] < 0.0));
+        let dd = p.d as f64;
+        if sum4_sign([far[0], far[1], far[2], dd]) == Some(Ordering::Less) {
             return (Relation::Outside, 0);
         }
-        if s - e < 0.0 || (s - e).is_nan() {
+        if !matches!(
+            sum4_sign([near[0], near[1], near[2], dd]),
+            Some(Ordering::Greater | Ordering::Equal)
+        ) {
             out_mask |= bit;
         }
     }
@@ -419,6 +683,158 @@ mod tests {
             ties += (scale == 1.0 && dd == rs) as u32;
         }
         assert!(ties > 100, "the grid must produce exact ties ({ties})");
+    }
+
+    /// A random `f32` on a coarse grid (exact ties are common) at one of several
+    /// magnitudes, mixed within one case.
+    fn coarse(rng: &mut rand_pcg::Pcg64) -> f32 {
+        use rand::Rng;
+        let scale = [1.0f32, 1.0 / 64.0, 1e-20, 1e15, 1e30][rng.gen_range(0..5)];
+        rng.gen_range(-8i32..=8) as f32 * scale
+    }
+
+    /// Hit or miss of `ray_sphere` decided from exact signs only (the reference
+    /// for its `f64` filters).
+    fn ray_sphere_exact_ref(ray: &Ray, s: &Sphere) -> bool {
+        let d = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+        if crate::geom::exact::within(d(ray.origin), d(s.center), s.radius as f64, 0.0) {
+            return true;
+        }
+        if ray_exact::m_dot_d(ray, s) != Ordering::Less {
+            return false;
+        }
+        if ray.max_t.is_infinite() || ray_exact::end_minus_closest(ray, s) != Ordering::Less {
+            ray_exact::line_gap(ray, s) != Ordering::Less
+        } else {
+            ray_exact::end_gap(ray, s) != Ordering::Less
+        }
+    }
+
+    /// `ray_sphere`'s filters never decide differently from the exact signs, and
+    /// every box containing a hit sphere is met by `ray_aabb` with an entry bound
+    /// not above the sphere's `t` (so index pruning is consistent), at every
+    /// magnitude from 1e-20 to 1e30.
+    #[test]
+    fn ray_tests_exact_and_consistent() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(12);
+        let (mut hits, mut exact_ties) = (0, 0);
+        for _ in 0..200_000 {
+            let mut v = || vec3(coarse(&mut rng), coarse(&mut rng), coarse(&mut rng));
+            let (o, c, dir) = (v(), v(), v());
+            if dir == Vec3::ZERO {
+                continue;
+            }
+            let r = coarse(&mut rng).abs();
+            let max_t = [f32::INFINITY, 1.0, 0.5, 3.0][rng.gen_range(0..4)];
+            let ray = Ray::with_max_t(o, dir, max_t);
+            let s = Sphere::new(c, r);
+            let got = ray_sphere(&ray, &s);
+            assert_eq!(
+                got.is_some(),
+                ray_sphere_exact_ref(&ray, &s),
+                "{ray:?} {s:?}"
+            );
+            let Some(t) = got else { continue };
+            hits += 1;
+            assert!((0.0..=max_t).contains(&t), "{t} {ray:?} {s:?}");
+            let b = outward_box(&s);
+            exact_ties += (b.min == c - Vec3::splat(r)) as u32;
+            for _ in 0..4 {
+                let mut grow = || [0.0, 1.0, 1e10, 1e30][rng.gen_range(0..4)];
+                let lo = b.min - vec3(grow(), grow(), grow());
+                let hi = b.max + vec3(grow(), grow(), grow());
+                let (t0, t1) = ray_aabb(&ray, &Aabb::new(lo, hi)).expect("box pruned a hit");
+                assert!(t0 <= t && t <= t1, "{t0} {t} {t1} {ray:?} {s:?}");
+            }
+        }
+        assert!(hits > 10_000 && exact_ties > 1_000, "{hits} {exact_ties}");
+    }
+
+    /// The far segment of `fuzz/found/index_ops-far-segment`'s kind: its numbers
+    /// dwarf its distance to the sphere by 1e16; the exact test still tells a
+    /// touching sphere from one a single `f32` step smaller.
+    #[test]
+    fn ray_sphere_far_segment_exact() {
+        let seg = crate::geom::Segment::new(vec3(1e20, 0.0, 0.0), vec3(-32.0, 0.0, 0.0));
+        let ray = seg.to_ray();
+        let touching = Sphere::new(vec3(0.0, 8000.0, 0.0), 8000.0);
+        let t = ray_sphere(&ray, &touching).expect("touching counts");
+        assert!((t - 1.0).abs() < 1e-6, "{t}");
+        let smaller = Sphere::new(vec3(0.0, 8000.0, 0.0), step_down(8000.0));
+        assert_eq!(ray_sphere(&ray, &smaller), None);
+    }
+
+    /// Frustum tests, exactly: the `f64` filter agrees with exact signs, and
+    /// a box's classification never contradicts a sphere inside it (box outside
+    /// ⇒ sphere outside; box inside ⇒ sphere kept), for random (also non-unit
+    /// and zero) plane normals at every magnitude.
+    #[test]
+    fn frustum_tests_exact_and_consistent() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(13);
+        let mut outs = [0; 3];
+        for _ in 0..100_000 {
+            let mut v = || vec3(coarse(&mut rng), coarse(&mut rng), coarse(&mut rng));
+            let planes = [(); 6].map(|_| crate::geom::Plane::new(v(), v().x));
+            let f = Frustum::from_planes(planes);
+            let s = Sphere::new(v(), v().x.abs());
+            let rel = frustum_sphere(&f, &s);
+            // Exact reference: per plane, signs of n·c + d ± r|n|.
+            let mut want = Relation::Inside;
+            for p in &f.planes {
+                let (n, dd, c) = (d3(p.normal), p.d as f64, d3(s.center));
+                let outer = exact_plane_sign(n, dd, c, s.radius as f64, 1.0);
+                if outer == Ordering::Less {
+                    want = Relation::Outside;
+                    break;
+                }
+                if exact_plane_sign(n, dd, c, s.radius as f64, -1.0) == Ordering::Less {
+                    want = Relation::Intersecting;
+                }
+            }
+            assert_eq!(rel, want, "{f:?} {s:?}");
+            outs[rel as usize] += 1;
+            let b = outward_box(&s);
+            let mut grow = || [0.0, 1.0, 1e30][rng.gen_range(0..3)];
+            let bx = Aabb::new(
+                b.min - vec3(grow(), grow(), grow()),
+                b.max + vec3(grow(), grow(), grow()),
+            );
+            match frustum_aabb(&f, &bx, Frustum::ALL_PLANES).0 {
+                Relation::Outside => assert_eq!(rel, Relation::Outside, "{f:?} {s:?} {bx:?}"),
+                Relation::Inside => assert_ne!(rel, Relation::Outside, "{f:?} {s:?} {bx:?}"),
+                Relation::Intersecting => {}
+            }
+        }
+        assert!(outs.iter().all(|&n| n > 300), "{outs:?}");
+    }
+
+    /// Sign of `n·c + d + sign·r|n|` from expansions only.
+    fn exact_plane_sign(n: [f64; 3], dd: f64, c: [f64; 3], r: f64, sign: f64) -> Ordering {
+        let de = (0..3).fold(Exp::of(dd), |e, i| e.add(&Exp::of(n[i] * c[i])));
+        let rn2 = (0..3).fold(Exp::default(), |e, i| {
+            e.add(&Exp::of(r * n[i]).mul(&Exp::of(r * n[i])))
+        });
+        let rn_sign = if rn2.sign() == Ordering::Equal {
+            Ordering::Equal
+        } else if sign > 0.0 {
+            Ordering::Greater
+        } else {
+            Ordering::Less
+        };
+        let ds = de.sign();
+        if ds == rn_sign || rn_sign == Ordering::Equal {
+            return ds;
+        }
+        if ds == Ordering::Equal {
+            return rn_sign;
+        }
+        match de.mul(&de).sub(&rn2).sign() {
+            Ordering::Greater => ds,
+            Ordering::Less => rn_sign,
+            Ordering::Equal => Ordering::Equal,
+        }
     }
 
     #[test]

@@ -55,7 +55,24 @@ impl TriMesh {
         self.triangles.is_empty()
     }
 
-    /// The corners of triangle `i`. Panics if `i >= len()`.
+    /// The corners of triangle `i`, or [`Error::IndexOutOfRange`] (naming `i` and
+    /// the triangle count) if `i >= len()`. O(1). The checked form of
+    /// [`TriMesh::triangle`] for indices that come from user input.
+    #[inline]
+    pub fn get_triangle(&self, i: usize) -> Result<[Vec3; 3]> {
+        if i >= self.triangles.len() {
+            return Err(Error::IndexOutOfRange {
+                what: "triangle",
+                index: i,
+                len: self.triangles.len(),
+            });
+        }
+        Ok(self.triangle(i))
+    }
+
+    /// The corners of triangle `i`. O(1). Panics if `i >= len()`, like slice
+    /// indexing: for indices from a loop over `0..len()` or from this crate's
+    /// own results (BVH hits); use [`TriMesh::get_triangle`] for anything else.
     #[inline]
     pub fn triangle(&self, i: usize) -> [Vec3; 3] {
         let [a, b, c] = self.triangles[i];
@@ -100,5 +117,22 @@ mod tests {
         assert!(TriMesh::new(bad, vec![[0, 1, 2]]).is_err());
         // Degenerate triangles are allowed.
         assert!(TriMesh::new(v, vec![[0, 0, 0]]).is_ok());
+    }
+
+    #[test]
+    fn get_triangle_out_of_range_is_an_error() {
+        let m = TriMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap();
+        assert_eq!(m.get_triangle(0), Ok([Vec3::ZERO, Vec3::X, Vec3::Y]));
+        let e = m.get_triangle(1).unwrap_err();
+        assert_eq!(
+            e,
+            Error::IndexOutOfRange {
+                what: "triangle",
+                index: 1,
+                len: 1
+            }
+        );
+        assert_eq!(e.to_string(), "triangle index 1 out of range (there are 1)");
+        assert!(m.get_triangle(usize::MAX).is_err());
     }
 }

@@ -174,7 +174,7 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid2d<T> {
     fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         sphere.validate()?;
         let rect = self.geom.sphere_rect(&sphere);
-        let h = self.items.insert(Item { rect, value });
+        let h = self.items.insert(Item { rect, value })?;
         let slot = h.index() as usize;
         if self.handles.len() <= slot {
             self.handles.resize(slot + 1, h);

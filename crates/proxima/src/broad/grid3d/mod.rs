@@ -165,9 +165,11 @@ impl<T> UniformGrid3d<T> {
 impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
     fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         sphere.validate()?;
+        // Room first: a full arena must leave the grid exactly as it was.
+        self.items.check_room()?;
         let slot = self.items.next_handle().index();
         let loc = self.place(slot, sphere);
-        let h = self.items.insert(value);
+        let h = self.items.insert(value)?;
         debug_assert_eq!(h.index(), slot);
         if self.locs.len() <= slot as usize {
             self.locs.resize(slot as usize + 1, loc);

@@ -162,10 +162,15 @@ impl Keys {
     }
 
     /// A cell's loose box grown by the padding (see the 2D grid for why).
+    ///
+    /// An object's key box reaches `2 (|c| + r) REL_PAD + pad` beyond its sphere
+    /// (`sphere_box` pads once, `span` again), so its lowest cell, from which
+    /// queries report it, may be that far from it: the growth must cover both
+    /// (3× the relative pad; a 2.6e24 cell and an object at 1e30 lost a pair).
     #[inline]
     pub fn padded(&self, b: &Aabb) -> Aabb {
         let m = b.min.abs().max(b.max.abs()).max_element();
-        b.grown(self.pad + m * REL_PAD)
+        b.grown(self.pad + m * (3.0 * REL_PAD))
     }
 }
 

@@ -195,9 +195,11 @@ impl<T> HashGrid<T> {
     /// The loose box of cell `key`: a box containing every sphere it references.
     #[inline]
     fn loose(&self, key: Key) -> Aabb {
-        let min = glam::IVec3::from(key).as_vec3() * self.keys.cell;
-        let max = min + glam::Vec3::splat(self.keys.cell);
         let k = glam::IVec3::from(key);
+        let min = k.as_vec3() * self.keys.cell;
+        // `(k + 1) * cell`, not `min + cell`: with a huge cell `min` may overflow
+        // to -∞, and the cell's upper side must stay finite.
+        let max = (k + 1).as_vec3() * self.keys.cell;
         let open_lo = k.cmple(glam::IVec3::splat(-keys::LIMIT));
         let open_hi = k.cmpge(glam::IVec3::splat(keys::LIMIT));
         self.keys
@@ -208,6 +210,7 @@ impl<T> HashGrid<T> {
 impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
     fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         sphere.validate()?;
+        self.items.check_room()?;
         let cells = self.cells_of(&sphere);
         let h = self.items.next_handle();
         let slot = h.index();
@@ -222,7 +225,7 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
                 Place::Oversized(self.oversized.len() as u32 - 1)
             }
         };
-        let h2 = self.items.insert(Item { place, value });
+        let h2 = self.items.insert(Item { place, value })?;
         debug_assert_eq!(h, h2);
         if self.handles.len() <= slot as usize {
             self.handles.resize(slot as usize + 1, h);

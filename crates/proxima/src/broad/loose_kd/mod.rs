@@ -224,11 +224,13 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     /// Seed `Push`: O(depth), creating the missing nodes on the way.
     fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         sphere.validate()?;
+        // Before `cover` and `descend` change the tree: a full index stays as it was.
+        self.items.check_room()?;
         self.cover(&sphere);
         let root = self.ensure_root();
         let node = self.descend(root, &sphere);
         let pos = self.nodes[node].slots.len() as u32;
-        let handle = self.items.insert(Loc { node, pos });
+        let handle = self.items.insert(Loc { node, pos })?;
         self.nodes[node].slots.push(Slot {
             sphere,
             handle,

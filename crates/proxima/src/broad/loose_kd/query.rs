@@ -133,8 +133,9 @@ impl<T> LooseKdTree<T> {
     /// ray's `max_t` shrinks to the best hit so far, children are visited nearer
     /// entry first, and a subtree whose region (which contains all its spheres) the
     /// shortened ray does not reach is skipped. `t` values come from the same
-    /// `overlap::ray_sphere` as the default scan, and `max_t` does not change the `t`
-    /// it returns, only whether it is returned, so the answer is identical.
+    /// `overlap::ray_sphere` on the unshortened ray, as in the default scan, so the
+    /// answer is identical: a pruned box has `ray_aabb`'s entry bound above the
+    /// best `t`, and that bound is at most the `t` of every sphere inside.
     pub(super) fn ray_first_impl(&self, ray: &Ray) -> Option<RayHit> {
         if self.root == NIL {
             return None;
@@ -152,7 +153,9 @@ impl<T> LooseKdTree<T> {
             let node = &self.nodes[n];
             for slot in &node.slots {
                 let h = slot.handle;
-                if let Some(t) = overlap::ray_sphere(&r, &slot.sphere) {
+                // The full ray: its `t` is what brute force reports (`ray_sphere`
+                // clamps into `[.., max_t]`); the shortened `r` only prunes boxes.
+                if let Some(t) = overlap::ray_sphere(ray, &slot.sphere).filter(|&t| t <= r.max_t) {
                     let better = match best {
                         None => true,
                         Some(b) => (t, h) < (b.t, b.handle),

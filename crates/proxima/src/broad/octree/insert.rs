@@ -11,7 +11,7 @@ use crate::Result;
 impl<T> LinearOctree<T> {
     /// Inserts an already validated sphere: locate the leaf from the centre's code,
     /// append, update counts and extents up the chain, split if over capacity.
-    pub(super) fn insert_valid(&mut self, sphere: Sphere, value: T) -> Handle {
+    pub(super) fn insert_valid(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         let (key, ext) = self.placement(&sphere);
         let handle = self.objects.insert(Obj {
             sphere,
@@ -20,7 +20,7 @@ impl<T> LinearOctree<T> {
             leaf: NONE,
             slot: 0,
             value,
-        });
+        })?;
         let start = self.locate(key);
         let leaf = self.descend_to_leaf(start, key);
         self.push_item(
@@ -34,7 +34,7 @@ impl<T> LinearOctree<T> {
         self.add_count(leaf, NONE, 1);
         self.grow_extent(leaf, ext);
         self.split_if_full(leaf);
-        handle
+        Ok(handle)
     }
 
     /// Removes object `h` and returns its payload.

@@ -235,7 +235,7 @@ impl<T> LinearOctree<T> {
 impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
     fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         sphere.validate()?;
-        Ok(self.insert_valid(sphere, value))
+        self.insert_valid(sphere, value)
     }
 
     fn remove(&mut self, handle: Handle) -> Result<T> {

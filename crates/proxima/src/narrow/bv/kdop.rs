@@ -2,6 +2,7 @@
 
 use super::{clip_slab, BoundingVolume};
 use crate::geom::Ray;
+use crate::{Error, Result};
 use glam::{Affine3A, Vec3};
 
 /// A k-DOP: the intersection of `K/2` slabs `min_i <= dot(axis_i, p) <= max_i` with
@@ -119,10 +120,29 @@ impl<const K: usize> Kdop<K> {
         }
     }
 
-    /// Slab axis `i` (`i < K/2`), not normalized.
+    /// Slab axis `i`, not normalized, or [`Error::IndexOutOfRange`] unless
+    /// `i < K/2`. O(1).
     #[inline]
-    pub fn axis(i: usize) -> Vec3 {
+    pub fn axis(i: usize) -> Result<Vec3> {
+        Self::check_slab(i)?;
+        Ok(Self::slab_axis(i))
+    }
+
+    #[inline]
+    fn slab_axis(i: usize) -> Vec3 {
         Vec3::from_array(AXES[Self::axis_index(i)])
+    }
+
+    fn check_slab(i: usize) -> Result<()> {
+        if i < Self::H {
+            Ok(())
+        } else {
+            Err(Error::IndexOutOfRange {
+                what: "k-DOP slab",
+                index: i,
+                len: Self::H,
+            })
+        }
     }
 
     /// The empty k-DOP (every interval inverted), identity of [`BoundingVolume::merge`].
@@ -148,10 +168,12 @@ impl<const K: usize> Kdop<K> {
         }
     }
 
-    /// The slab interval along axis `i`.
+    /// The slab interval along axis `i`, or [`Error::IndexOutOfRange`] unless
+    /// `i < K/2`. O(1).
     #[inline]
-    pub fn interval(&self, i: usize) -> (f32, f32) {
-        (self.d[i], self.d[i + Self::H])
+    pub fn interval(&self, i: usize) -> Result<(f32, f32)> {
+        Self::check_slab(i)?;
+        Ok((self.d[i], self.d[i + Self::H]))
     }
 
     /// True if `p` satisfies every slab (closed).
@@ -219,7 +241,7 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
         let pc = project13(wc);
         let mut d = [0.0; K];
         for i in 0..Self::H {
-            let u = Self::axis(i);
+            let u = Self::slab_axis(i);
             let v = Vec3::from(rt * glam::Vec3A::from(u));
             let r = v.abs().dot(e);
             let m = pc[Self::axis_index(i)];
@@ -304,10 +326,23 @@ mod tests {
 
     #[test]
     fn axes_are_distinct_and_cover_the_seed_lists() {
-        assert_eq!(Kdop14::axis(3), Vec3::new(1.0, 1.0, 1.0));
-        assert_eq!(Kdop18::axis(3), Vec3::new(1.0, 1.0, 0.0));
-        assert_eq!(Kdop18::axis(8), Vec3::new(0.0, 1.0, -1.0));
-        assert_eq!(Kdop26::axis(12), Vec3::new(0.0, 1.0, -1.0));
+        assert_eq!(Kdop14::axis(3), Ok(Vec3::new(1.0, 1.0, 1.0)));
+        assert_eq!(Kdop18::axis(3), Ok(Vec3::new(1.0, 1.0, 0.0)));
+        assert_eq!(Kdop18::axis(8), Ok(Vec3::new(0.0, 1.0, -1.0)));
+        assert_eq!(Kdop26::axis(12), Ok(Vec3::new(0.0, 1.0, -1.0)));
+        // Out of range: a typed error, not a panic.
+        assert!(matches!(
+            Kdop14::axis(7),
+            Err(crate::Error::IndexOutOfRange {
+                index: 7,
+                len: 7,
+                ..
+            })
+        ));
+        let mut k = Kdop18::empty();
+        k.add_point(Vec3::ONE);
+        assert_eq!(k.interval(0), Ok((1.0, 1.0)));
+        assert!(k.interval(9).is_err());
         let p = Vec3::new(0.3, -1.7, 2.5);
         for (i, axis) in AXES.iter().enumerate() {
             assert_eq!(project13(p)[i], Vec3::from_array(*axis).dot(p));

@@ -60,9 +60,10 @@ impl<T> LooseKdTree<T> {
         classify(self.root, Frustum::ALL_PLANES, &mut stack);
         while let Some(p) = stack.pop() {
             let node = &self.nodes[p.node];
-            for slot in &node.slots {
-                if p.inside || query.selects(&slot.sphere) {
-                    f(slot.handle, &slot.sphere, &slot.value)?;
+            for (q, s) in node.range().zip(&self.store.sphere[node.range()]) {
+                if p.inside || query.selects(s) {
+                    let (h, v) = self.store.at(q);
+                    f(h, s, v)?;
                 }
             }
             let a = node.axis as usize;
@@ -116,9 +117,9 @@ impl<T> LooseKdTree<T> {
                 continue;
             }
             let node = &self.nodes[n];
-            for slot in &node.slots {
-                let h = slot.handle;
-                if let Some(t) = overlap::ray_sphere(&r, &slot.sphere) {
+            for (q, s) in node.range().zip(&self.store.sphere[node.range()]) {
+                if let Some(t) = overlap::ray_sphere(&r, s) {
+                    let h = self.store.at(q).0;
                     let better = match best {
                         None => true,
                         Some(b) => (t, h) < (b.t, b.handle),

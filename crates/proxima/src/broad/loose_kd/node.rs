@@ -11,9 +11,9 @@ pub(super) const NIL: u32 = u32::MAX;
 /// A tree node (seed `NODE`), flat in a [`Pool`](crate::arena::Pool).
 ///
 /// Laid out by hand (`repr(C)`, one cache line per node start): the fields the
-/// pair walk reads at every node (objects, children, split) come first, so a
-/// visit touches one line of the node; the boxes, read by insertion, moves and
-/// queries, follow.
+/// pair walk reads at every node (objects, children, split) and those a move
+/// reads (the cell and `h_up`) fill the first line; the box, read by insertion
+/// and queries, follows.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub(super) struct Node {
@@ -36,13 +36,15 @@ pub(super) struct Node {
     /// `h` never grows downwards, so this is the smallest `h` on the path.
     pub h_up: f32,
     pub parent: u32,
-    /// The seed's box `B`: the world box, narrowed by one face per split above.
-    pub bbox: Aabb,
     /// Where the centres of spheres routed through this node lie: per split above,
     /// `c_a > m` (positive side, `cell.min` exclusive) or `c_a <= m` (negative side,
     /// `cell.max` inclusive). Unsplit faces are infinite: the rule ignores the
     /// world box. Lets a move check in O(1) that the placement is unchanged.
+    /// In the first cache line, with `h_up`, `h`, `depth` and `start`: a move
+    /// that keeps its node reads only that line.
     pub cell: Aabb,
+    /// The seed's box `B`: the world box, narrowed by one face per split above.
+    pub bbox: Aabb,
 }
 
 impl Node {

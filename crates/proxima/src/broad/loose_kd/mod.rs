@@ -41,7 +41,10 @@ use store::Store;
 /// objects in one depth-first array (`store.rs`), 0.15 beat 0.2 at N = 100k
 /// (frame ~5–10% faster, 138 instead of 200 bytes per object, build twice as
 /// fast) and at 10k (~5–10%); 0.12 and 0.1 were 20–40% slower at 100k, 0.3 and
-/// 0.4 1.5–2× slower. Lower densities widen the border zones (more spheres stop
+/// 0.4 1.5–2× slower. The trade-off is scene-dependent: on W2 (flat world)
+/// 0.15 was also ~20% faster, but on W3 (tight clusters, ~7 pairs per object) its
+/// pair search was ~20–30% slower than with 0.2; pass a higher density for such
+/// scenes. Lower densities widen the border zones (more spheres stop
 /// high in the tree, more cross tests); higher ones deepen the tree (more nodes
 /// to walk and more moves that change node).
 pub const DEFAULT_DENSITY: f32 = 0.15;

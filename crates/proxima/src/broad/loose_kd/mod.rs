@@ -17,6 +17,7 @@ mod pairs;
 mod pairs_par;
 mod query;
 mod stats;
+mod store;
 mod update;
 mod validate;
 mod visit;
@@ -31,17 +32,22 @@ use crate::arena::{Arena, Handle, Pool};
 use crate::broad::{RayHit, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Result};
-use node::{Node, Slot, NIL};
+use node::{Node, NIL};
 use std::ops::ControlFlow;
+use store::Store;
 
 /// A good density for scenes of many similar spheres moving a little per frame
-/// (design §5, W1): measured with the W1 frame (update all + all pairs) at
-/// N = 10k and 100k over densities 0.15–0.4, 0.2 was fastest at both sizes
-/// (0.25 about 10% slower, 0.3 20–35% slower, 0.15 slightly slower). Lower
-/// densities widen the border zones (more spheres stop high in the tree, more
-/// cross tests); higher ones deepen the tree (more nodes to walk and more moves
-/// that change node).
-pub const DEFAULT_DENSITY: f32 = 0.2;
+/// (design §5, W1): measured with the W1 frame (update all + all pairs). With the
+/// objects in one depth-first array (`store.rs`), 0.15 beat 0.2 at N = 100k
+/// (frame ~5–10% faster, 138 instead of 200 bytes per object, build twice as
+/// fast) and at 10k (~5–10%); 0.12 and 0.1 were 20–40% slower at 100k, 0.3 and
+/// 0.4 1.5–2× slower. The trade-off is scene-dependent: on W2 (flat world)
+/// 0.15 was also ~20% faster, but on W3 (tight clusters, ~7 pairs per object) its
+/// pair search was ~20–30% slower than with 0.2; pass a higher density for such
+/// scenes. Lower densities widen the border zones (more spheres stop
+/// high in the tree, more cross tests); higher ones deepen the tree (more nodes
+/// to walk and more moves that change node).
+pub const DEFAULT_DENSITY: f32 = 0.15;
 
 /// Largest accepted depth cap (it also sizes the fixed traversal stacks).
 pub const MAX_DEPTH_LIMIT: u8 = 64;
@@ -51,8 +57,9 @@ pub const MAX_DEPTH_LIMIT: u8 = 64;
 /// point stop after 40 levels instead of recursing until `f32` runs out of bits.
 pub const DEFAULT_MAX_DEPTH: u8 = 40;
 
-/// Where a stored object is: its node and its position in the node's `slots`.
-/// The handle arena holds only this; the object itself lives in its node.
+/// Where a stored object is: its node and its position in the node's range of
+/// the object array. The handle arena holds only this; the object itself is in
+/// the array (`store.rs`).
 #[derive(Clone, Copy, Debug)]
 struct Loc {
     node: u32,
@@ -90,11 +97,13 @@ struct Loc {
 ///
 /// # Costs
 ///
-/// Memory: one node per occupied cell (`size_of` = 128 bytes, one cache-line-aligned block) whose objects
-/// (sphere, handle, payload) are stored contiguously in a vector owned by the node,
-/// plus one small arena slot per object giving its node and position. Nodes live in
-/// a pooled arena with a free list and the vectors of freed nodes are recycled, so
-/// steady-state moves do not allocate. Insert and a move that leaves the node's
+/// Memory: one node per occupied cell (`size_of` = 128 bytes, one cache-line-aligned
+/// block); the objects (sphere, handle, payload) of all nodes share one array in
+/// which each node owns a contiguous range with some spare room (up to ~1.5 spare or
+/// dead positions per object, see `store.rs`), plus one small arena slot per object
+/// giving its node and position. Nodes live in a pooled arena with a free list; the
+/// array and the nodes are periodically compacted into depth-first order, which is
+/// the order the pair search and the queries read them in. Insert and a move that leaves the node's
 /// cell are O(depth); a move inside the cell is O(1); removal is O(1) (swap with the
 /// node's last object) plus freeing emptied ancestors. Depth is
 /// capped ([`DEFAULT_MAX_DEPTH`], or [`LooseKdTree::with_max_depth`]): at the cap a
@@ -111,11 +120,11 @@ struct Loc {
 /// and box queries, which prune with the split planes only, are unaffected.
 #[derive(Clone, Debug)]
 pub struct LooseKdTree<T> {
-    /// Handle → location; the objects themselves are in their nodes' `slots`.
+    /// Handle → location; the objects themselves are in `store`.
     items: Arena<Loc>,
-    nodes: Pool<Node<T>>,
-    /// Emptied `slots` vectors of freed nodes, reused by new nodes.
-    spare: Vec<Vec<Slot<T>>>,
+    nodes: Pool<Node>,
+    /// The objects, each node's in its own contiguous range.
+    store: Store<T>,
     /// Buffers of the pair search, reused between calls.
     scratch: pairs::PairScratch,
     root: u32,
@@ -167,7 +176,7 @@ impl<T> LooseKdTree<T> {
         let mut t = LooseKdTree {
             items: Arena::new(),
             nodes: Pool::default(),
-            spare: Vec::new(),
+            store: Store::default(),
             scratch: Default::default(),
             root: NIL,
             world,
@@ -229,24 +238,21 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.cover(&sphere);
         let root = self.ensure_root();
         let node = self.descend(root, &sphere);
-        let pos = self.nodes[node].slots.len() as u32;
-        let handle = self.items.insert(Loc { node, pos })?;
-        self.nodes[node].slots.push(Slot {
-            sphere,
-            handle,
-            value,
-        });
+        let handle = self.items.insert(Loc { node, pos: 0 })?;
+        self.put(node, sphere, handle, value);
+        self.maybe_compact();
         Ok(handle)
     }
 
     /// Seed `Pop`: O(1) swap-remove from the node, then frees emptied nodes upwards.
     fn remove(&mut self, handle: Handle) -> Result<T> {
         let loc = *self.items.get(handle)?;
-        let slot = self.take_slot(loc);
+        let (_, _, value) = self.take(loc);
         self.prune_up(loc.node);
         self.items.remove(handle)?;
         self.reset_span_if_empty();
-        Ok(slot.value)
+        self.maybe_compact();
+        Ok(value)
     }
 
     /// Seed `Move`; see the type's docs for when the object changes node.
@@ -260,13 +266,15 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
 
     fn get(&self, handle: Handle) -> Result<(Sphere, &T)> {
         let loc = self.items.get(handle)?;
-        let slot = &self.nodes[loc.node].slots[loc.pos as usize];
-        Ok((slot.sphere, &slot.value))
+        let p = (self.nodes[loc.node].start + loc.pos) as usize;
+        Ok((self.store.sphere[p], self.store.at(p).1))
     }
 
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
         let loc = *self.items.get(handle)?;
-        Ok(&mut self.nodes[loc.node].slots[loc.pos as usize].value)
+        let p = (self.nodes[loc.node].start + loc.pos) as usize;
+        let (_, v) = self.store.entry[p].as_mut().expect("live position");
+        Ok(v)
     }
 
     fn len(&self) -> usize {
@@ -277,7 +285,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     fn clear(&mut self) {
         self.items.clear();
         self.nodes.clear();
-        self.spare = Vec::new();
+        self.store = Store::default();
         self.scratch = Default::default();
         self.root = NIL;
         self.span = self.world;
@@ -286,8 +294,9 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
 
     fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
         for (_, loc) in self.items.iter() {
-            let slot = &self.nodes[loc.node].slots[loc.pos as usize];
-            f(slot.handle, &slot.sphere, &slot.value);
+            let p = (self.nodes[loc.node].start + loc.pos) as usize;
+            let (h, v) = self.store.at(p);
+            f(h, &self.store.sphere[p], v);
         }
     }
 
@@ -300,7 +309,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     }
 
     /// Node-vs-node walk over the nodes' contiguous objects (see `pairs.rs`). Its
-    /// buffers (24 bytes per carried object) are kept in the tree and reused, so
+    /// buffers (20 bytes per carried object) are kept in the tree and reused, so
     /// repeated calls do not allocate once they have grown.
     fn for_each_pair(
         &self,
@@ -319,28 +328,13 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.validate_impl()
     }
 
-    /// The struct plus the capacity of the handle arena, the node pool, the nodes'
-    /// object vectors, the spare vectors and the pair-search buffers. O(nodes).
+    /// The struct plus the capacity of the handle arena, the node pool, the object
+    /// array and the pair-search buffers. O(1).
     fn memory_bytes(&self) -> usize {
-        let slot = std::mem::size_of::<Slot<T>>();
-        let mut slots = self.spare.capacity() * std::mem::size_of::<Vec<Slot<T>>>();
-        slots += self
-            .spare
-            .iter()
-            .map(|v| v.capacity() * slot)
-            .sum::<usize>();
-        if self.root != NIL {
-            let mut stack = vec![self.root];
-            while let Some(n) = stack.pop() {
-                let node = &self.nodes[n];
-                slots += node.slots.capacity() * slot;
-                stack.extend(node.child.into_iter().filter(|&c| c != NIL));
-            }
-        }
         std::mem::size_of::<Self>()
             + self.items.heap_bytes()
             + self.nodes.heap_bytes()
+            + self.store.heap_bytes()
             + self.scratch.heap_bytes()
-            + slots
     }
 }

@@ -2,36 +2,27 @@
 //! region of a subtree, and a fixed-size traversal stack.
 
 use super::LooseKdTree;
-use crate::arena::Handle;
 use crate::geom::{Aabb, Sphere};
 use glam::Vec3;
 
 /// "No node / no item".
 pub(super) const NIL: u32 = u32::MAX;
 
-/// An object as stored in its node: the node's objects are one contiguous run, so
-/// queries and the pair search read spheres, handles and payloads without going
-/// back to the handle arena.
-#[derive(Clone, Debug)]
-pub(super) struct Slot<T> {
-    pub sphere: Sphere,
-    pub handle: Handle,
-    pub value: T,
-}
-
 /// A tree node (seed `NODE`), flat in a [`Pool`](crate::arena::Pool).
 ///
 /// Laid out by hand (`repr(C)`, one cache line per node start): the fields the
-/// pair walk reads at every node (objects, children, split) come first, so a
-/// visit touches one line of the node; the boxes, read by insertion, moves and
-/// queries, follow.
-#[derive(Clone, Debug)]
+/// pair walk reads at every node (objects, children, split) and those a move
+/// reads (the cell and `h_up`) fill the first line; the box, read by insertion
+/// and queries, follows.
+#[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(super) struct Node<T> {
-    /// The objects attached here, in no particular order (removal swaps the last
-    /// one into the hole). The vector is recycled through the tree's spare list
-    /// when the node is freed, so steady-state moves do not allocate.
-    pub slots: Vec<Slot<T>>,
+pub(super) struct Node {
+    /// The objects attached here are at positions `start .. start + len` of the
+    /// tree's object array (`store.rs`), in no particular order (removal swaps the
+    /// last one into the hole); the range has room for `cap`.
+    pub start: u32,
+    pub len: u32,
+    pub cap: u32,
     /// `[negative, positive]`.
     pub child: [u32; 2],
     /// Centre of `bbox` on the split axis.
@@ -45,18 +36,20 @@ pub(super) struct Node<T> {
     /// `h` never grows downwards, so this is the smallest `h` on the path.
     pub h_up: f32,
     pub parent: u32,
-    /// The seed's box `B`: the world box, narrowed by one face per split above.
-    pub bbox: Aabb,
     /// Where the centres of spheres routed through this node lie: per split above,
     /// `c_a > m` (positive side, `cell.min` exclusive) or `c_a <= m` (negative side,
     /// `cell.max` inclusive). Unsplit faces are infinite: the rule ignores the
     /// world box. Lets a move check in O(1) that the placement is unchanged.
+    /// In the first cache line, with `h_up`, `h`, `depth` and `start`: a move
+    /// that keeps its node reads only that line.
     pub cell: Aabb,
+    /// The seed's box `B`: the world box, narrowed by one face per split above.
+    pub bbox: Aabb,
 }
 
-impl<T> Node<T> {
-    /// A node over `bbox` holding nothing yet (`slots` must be empty: a recycled
-    /// vector); split axis, `m` and `h` are derived from it.
+impl Node {
+    /// A node over `bbox` holding nothing yet (no room either: the first object
+    /// placed gives it a range); split axis, `m` and `h` are derived from it.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         bbox: Aabb,
@@ -66,9 +59,7 @@ impl<T> Node<T> {
         depth: u8,
         r_max: f32,
         density: f32,
-        slots: Vec<Slot<T>>,
-    ) -> Node<T> {
-        debug_assert!(slots.is_empty());
+    ) -> Node {
         let (axis, m, h) = split_of(&bbox, r_max, density);
         Node {
             bbox,
@@ -78,7 +69,9 @@ impl<T> Node<T> {
             h_up,
             parent,
             child: [NIL, NIL],
-            slots,
+            start: 0,
+            len: 0,
+            cap: 0,
             axis,
             depth,
         }
@@ -102,10 +95,16 @@ impl<T> Node<T> {
         (b, c)
     }
 
+    /// Positions of the node's objects in the object array.
+    #[inline]
+    pub fn range(&self) -> std::ops::Range<usize> {
+        self.start as usize..(self.start + self.len) as usize
+    }
+
     /// True when the node holds no item and has no child (it must then be freed).
     #[inline]
     pub fn is_empty(&self) -> bool {
-        self.slots.is_empty() && self.child[0] == NIL && self.child[1] == NIL
+        self.len == 0 && self.child[0] == NIL && self.child[1] == NIL
     }
 
     /// True if the placement rule routes `s` through this node: its centre is on
@@ -155,7 +154,7 @@ impl<T> LooseKdTree<T> {
     /// rounding in the callers' `f32` tests, so pruning never disagrees with the
     /// exact tests of `geom::overlap` on a sphere that touches a face.
     #[inline]
-    pub(super) fn region(&self, n: &Node<T>) -> Aabb {
+    pub(super) fn region(&self, n: &Node) -> Aabb {
         self.region_of_box(&n.bbox)
     }
 
@@ -172,14 +171,14 @@ impl<T> LooseKdTree<T> {
     /// Lower bound on the split axis of every sphere in the positive subtree of `n`
     /// (`c_a - r > m - h`), minus slack.
     #[inline]
-    pub(super) fn pos_floor(&self, n: &Node<T>) -> f32 {
+    pub(super) fn pos_floor(&self, n: &Node) -> f32 {
         n.m - n.h - self.eps
     }
 
     /// Upper bound on the split axis of every sphere in the negative subtree of `n`
     /// (`c_a + r < m + h`), plus slack.
     #[inline]
-    pub(super) fn neg_ceil(&self, n: &Node<T>) -> f32 {
+    pub(super) fn neg_ceil(&self, n: &Node) -> f32 {
         n.m + n.h + self.eps
     }
 }

@@ -16,13 +16,14 @@
 //!   overlap only in the border zone `[m - h, m + h]`, so only items near it take
 //!   part on either side.
 //!
-//! The walks read each node's objects where they are stored, contiguously in the
-//! node (`Node::slots`); the carried sets are copies of the spheres, one array per
-//! coordinate (structure of arrays, see [`Carried`]), with the object's node and
-//! position, so the inner loop tests one sphere against four carried ones with a
+//! The walks read each node's objects where they are stored: a contiguous range
+//! of the tree's object array (`store.rs`), which compaction keeps in the
+//! depth-first order of this walk; the carried sets are copies of the spheres, one array per
+//! coordinate (structure of arrays, see [`Carried`]), with the object's position
+//! in that array, so the inner loop tests one sphere against four carried ones with a
 //! branch-free `f32` pre-test that vectorizes (`overlap::sphere_sphere_candidate`)
 //! and runs the exact test only on the few candidates; only a reported pair goes
-//! back to the node for its handle and payload. A node's own objects are appended
+//! back to the object array for its handle and payload. A node's own objects are appended
 //! to the carried set first, so "own against ancestors" and "own against own" are
 //! the same scan. A node whose
 //! own and carried objects are many (typically a node high in the tree holding
@@ -30,7 +31,7 @@
 //! testing all pairs; the carried set is narrowed at each level except before a
 //! small leaf, where the copy would cost more than the tests it saves.
 
-use super::node::{FixedStack, Slot, NIL};
+use super::node::{FixedStack, NIL};
 use super::LooseKdTree;
 use crate::arena::Handle;
 use crate::geom::{overlap, Sphere};
@@ -42,8 +43,10 @@ use std::sync::{Mutex, TryLockError};
 /// all-pairs through the vectorized [`Carried::scan`]; from it on they use a sweep
 /// on the split axis. With the scan's eight tests per step, all-pairs stays
 /// cheaper than sorting well past the 48 that suited the scalar test (W1, 10k:
-/// 128 measured a little faster than 48, and no worse than never sweeping).
-const SWEEP_MIN: usize = 128;
+/// 128 measured a little faster than 48, and no worse than never sweeping). With
+/// the depth-first object array and density 0.15, W1 at 100k ran its pair search
+/// 15–25% faster with 256 than with 128 (512 about the same as 256).
+const SWEEP_MIN: usize = 256;
 
 /// Leaves with fewer objects are tested against their parent's carried set
 /// without narrowing it first (see `worth_filtering`).
@@ -53,7 +56,7 @@ const LEAF_FILTER_MIN: usize = 8;
 const LANES: usize = 4;
 
 /// A stack of carried objects in structure-of-arrays form: coordinates, radius
-/// and origin (node, position in the node) of entry `i` are `x[i]`, ..., `org[i]`.
+/// and origin (position in the object array) of entry `i` are `x[i]`, ..., `org[i]`.
 /// The vectors are kept at least `len` long (entries past `len` are garbage), so
 /// appending a filtered range is a branch-free write-then-advance.
 #[derive(Default)]
@@ -62,7 +65,7 @@ pub(super) struct Carried {
     y: Vec<f32>,
     z: Vec<f32>,
     r: Vec<f32>,
-    org: Vec<[u32; 2]>,
+    org: Vec<u32>,
     len: usize,
 }
 
@@ -87,14 +90,14 @@ impl Carried {
             self.y.resize(cap, 0.0);
             self.z.resize(cap, 0.0);
             self.r.resize(cap, 0.0);
-            self.org.resize(cap, [0; 2]);
+            self.org.resize(cap, 0);
         }
     }
 
     /// Writes `s` at the end; it is kept only if `keep` (branch-free). Needs
     /// room (see `reserve`).
     #[inline]
-    fn put(&mut self, s: &Sphere, org: [u32; 2], keep: bool) {
+    fn put(&mut self, s: &Sphere, org: u32, keep: bool) {
         let k = self.len;
         self.x[k] = s.center.x;
         self.y[k] = s.center.y;
@@ -104,17 +107,18 @@ impl Carried {
         self.len += keep as usize;
     }
 
-    /// Appends the objects of node `n` (all of them, or those with `keep`).
+    /// Appends the objects at positions `start..` of the object array whose
+    /// spheres are `spheres` (all of them, or those with `keep`).
     #[inline]
-    pub(super) fn push_node<T>(
+    pub(super) fn push_node(
         &mut self,
-        n: u32,
-        slots: &[Slot<T>],
+        start: usize,
+        spheres: &[Sphere],
         keep: impl Fn(&Sphere) -> bool,
     ) {
-        self.reserve(slots.len());
-        for (pos, x) in slots.iter().enumerate() {
-            self.put(&x.sphere, [n, pos as u32], keep(&x.sphere));
+        self.reserve(spheres.len());
+        for (i, s) in spheres.iter().enumerate() {
+            self.put(s, (start + i) as u32, keep(s));
         }
     }
 
@@ -124,10 +128,10 @@ impl Carried {
         Sphere::new(Vec3::new(self.x[i], self.y[i], self.z[i]), self.r[i])
     }
 
-    /// Node and position of entry `i`.
+    /// Position of entry `i` in the object array.
     #[inline]
-    fn origin(&self, i: usize) -> [u32; 2] {
-        self.org[i]
+    fn origin(&self, i: usize) -> usize {
+        self.org[i] as usize
     }
 
     /// Lower (`c_a - r`) or upper (`c_a + r`) end of entry `i` on `axis`.
@@ -285,7 +289,7 @@ impl Carried {
 
     fn heap_bytes(&self) -> usize {
         4 * self.x.capacity() * std::mem::size_of::<f32>()
-            + self.org.capacity() * std::mem::size_of::<[u32; 2]>()
+            + self.org.capacity() * std::mem::size_of::<u32>()
     }
 }
 
@@ -362,25 +366,23 @@ impl<T> LooseKdTree<T> {
         j: usize,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let [xn, xp] = c.origin(i);
-        let [yn, yp] = c.origin(j);
-        let x = &self.nodes[xn].slots[xp as usize];
-        let y = &self.nodes[yn].slots[yp as usize];
-        f(x.handle, &x.value, y.handle, &y.value)
+        let (xh, xv) = self.store.at(c.origin(i));
+        let (yh, yv) = self.store.at(c.origin(j));
+        f(xh, xv, yh, yv)
     }
 
-    /// Reports carried entry `i` with stored object `y`.
+    /// Reports carried entry `i` with the object at position `y`.
     #[inline]
-    fn report_slot(
+    fn report_at(
         &self,
         c: &Carried,
         i: usize,
-        y: &Slot<T>,
+        y: usize,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let [xn, xp] = c.origin(i);
-        let x = &self.nodes[xn].slots[xp as usize];
-        f(x.handle, &x.value, y.handle, &y.value)
+        let (xh, xv) = self.store.at(c.origin(i));
+        let (yh, yv) = self.store.at(y);
+        f(xh, xv, yh, yv)
     }
 
     /// Whether to narrow the carried set before visiting node `c`. The filter only
@@ -391,7 +393,7 @@ impl<T> LooseKdTree<T> {
     #[inline]
     pub(super) fn worth_filtering(&self, c: u32) -> bool {
         let node = &self.nodes[c];
-        node.child != [NIL, NIL] || node.slots.len() >= LEAF_FILTER_MIN
+        node.child != [NIL, NIL] || node.len as usize >= LEAF_FILTER_MIN
     }
 
     /// Prepares the carried set `c[active..end]` (objects that reach `n`'s region)
@@ -446,17 +448,16 @@ impl<T> LooseKdTree<T> {
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let node = &self.nodes[n];
-        let own = &node.slots[..];
+        let start = node.start as usize;
+        let own = &self.store.sphere[node.range()];
         let base = b.c.len();
-        b.c.push_node(n, own, |_| true);
+        b.c.push_node(start, own, |_| true);
         if own.len() > 1 && b.c.len() - active >= SWEEP_MIN {
             self.sweep(active, base, node.axis as usize, b, f)?;
         } else {
             for (i, y) in own.iter().enumerate() {
                 let c = &b.c;
-                c.scan(active, base + i, &y.sphere, |k| {
-                    self.report_slot(c, k, y, f)
-                })?;
+                c.scan(active, base + i, y, |k| self.report_at(c, k, start + i, f))?;
             }
         }
         ControlFlow::Continue(())
@@ -566,7 +567,9 @@ impl<T> LooseKdTree<T> {
         stack.push(p);
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n];
-            c.push_node(n, &node.slots, |s| s.center[axis] + s.radius >= floor);
+            c.push_node(node.start as usize, &self.store.sphere[node.range()], |s| {
+                s.center[axis] + s.radius >= floor
+            });
             let [neg, pos] = node.child;
             if neg != NIL && (node.axis as usize != axis || self.neg_ceil(node) >= floor) {
                 stack.push(neg);
@@ -591,12 +594,12 @@ impl<T> LooseKdTree<T> {
         let node = &self.nodes[n];
         let end = c.len();
         let (axis, ceil) = border;
-        for y in &node.slots {
-            if y.sphere.center[axis] - y.sphere.radius > ceil {
+        for (p, y) in node.range().zip(&self.store.sphere[node.range()]) {
+            if y.center[axis] - y.radius > ceil {
                 continue;
             }
             let cs = &*c;
-            cs.scan(active, end, &y.sphere, |k| self.report_slot(cs, k, y, f))?;
+            cs.scan(active, end, y, |k| self.report_at(cs, k, p, f))?;
         }
         let same_axis = node.axis as usize == axis;
         for side in 0..2 {

@@ -78,8 +78,9 @@ impl<T> LooseKdTree<T> {
         while let Some(p) = stack.pop() {
             let node = &self.nodes[p.node];
             if p.inside {
-                for slot in &node.slots {
-                    f(slot.handle, &slot.sphere, &slot.value)?;
+                for (q, s) in node.range().zip(&self.store.sphere[node.range()]) {
+                    let (h, v) = self.store.at(q);
+                    f(h, s, v)?;
                 }
                 for c in node.child {
                     if c != NIL {
@@ -119,10 +120,11 @@ impl<T> LooseKdTree<T> {
             }
             // The node's own objects after its children are classified: the
             // children's tests need only this node's fields, and the scan's
-            // first load (the object list, a separate allocation) is the miss.
-            for slot in &node.slots {
-                if query.selects(&slot.sphere) {
-                    f(slot.handle, &slot.sphere, &slot.value)?;
+            // first load (the node's range of the object array) is the miss.
+            for (q, s) in node.range().zip(&self.store.sphere[node.range()]) {
+                if query.selects(s) {
+                    let (h, v) = self.store.at(q);
+                    f(h, s, v)?;
                 }
             }
         }
@@ -151,11 +153,11 @@ impl<T> LooseKdTree<T> {
                 continue;
             }
             let node = &self.nodes[n];
-            for slot in &node.slots {
-                let h = slot.handle;
+            for (q, s) in node.range().zip(&self.store.sphere[node.range()]) {
                 // The full ray: its `t` is what brute force reports (`ray_sphere`
                 // clamps into `[.., max_t]`); the shortened `r` only prunes boxes.
-                if let Some(t) = overlap::ray_sphere(ray, &slot.sphere).filter(|&t| t <= r.max_t) {
+                if let Some(t) = overlap::ray_sphere(ray, s).filter(|&t| t <= r.max_t) {
+                    let h = self.store.at(q).0;
                     let better = match best {
                         None => true,
                         Some(b) => (t, h) < (b.t, b.handle),

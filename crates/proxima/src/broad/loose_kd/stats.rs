@@ -53,8 +53,8 @@ impl<T> LooseKdTree<T> {
             if s.items_per_depth.len() <= d {
                 s.items_per_depth.resize(d + 1, 0);
             }
-            s.items_per_depth[d] += node.slots.len();
-            s.max_items_per_node = s.max_items_per_node.max(node.slots.len());
+            s.items_per_depth[d] += node.len as usize;
+            s.max_items_per_node = s.max_items_per_node.max(node.len as usize);
             if node.child == [NIL, NIL] {
                 s.leaves += 1;
             }

@@ -12,9 +12,8 @@ impl<T> LooseKdTree<T> {
             return None;
         }
         let p = self.nodes[n].parent;
-        // Keep the (empty) vector's capacity for the next node created.
-        let slots = std::mem::take(&mut self.nodes[n].slots);
-        self.spare.push(slots);
+        // Its (empty) range is dead until the next compaction.
+        self.store.dead += self.nodes[n].cap as usize;
         if p == NIL {
             self.root = NIL;
         } else {
@@ -44,13 +43,12 @@ impl<T> LooseKdTree<T> {
     /// routes `s` (the root always does), and insert from there: O(climb + descent).
     pub(super) fn move_item(&mut self, loc: Loc, s: Sphere) {
         let max_depth = self.max_depth;
-        let n = &mut self.nodes[loc.node];
+        let n = &self.nodes[loc.node];
         if n.routes(&s) && (s.radius >= n.h || n.depth >= max_depth) {
-            n.slots[loc.pos as usize].sphere = s;
+            self.store.sphere[(n.start + loc.pos) as usize] = s;
             return;
         }
-        let mut slot = self.take_slot(loc);
-        slot.sphere = s;
+        let (_, handle, value) = self.take(loc);
         let mut cur = loc.node;
         while !self.nodes[cur].routes(&s) {
             let parent = self.nodes[cur].parent;
@@ -59,6 +57,7 @@ impl<T> LooseKdTree<T> {
             cur = parent;
         }
         let target = self.descend(cur, &s);
-        self.put_slot(target, slot);
+        self.put(target, s, handle, value);
+        self.maybe_compact();
     }
 }

@@ -14,8 +14,9 @@ impl<T> LooseKdTree<T> {
     /// from the world box); `h` never growing downwards; the depth cap; no empty
     /// node; every stored object's handle live and locating exactly its slot, and
     /// every object placed exactly where the placement rule puts it (with the
-    /// object count, this makes handles and slots a bijection); spare vectors empty; `span` covering the world and every
-    /// sphere. O(nodes + items).
+    /// object count, this makes handles and slots a bijection); node ranges inside the object array,
+    /// disjoint, live positions filled and the rest empty, the dead count exact;
+    /// `span` covering the world and every sphere. O(nodes + array length).
     pub(super) fn validate_impl(&self) -> Result<()> {
         self.items.validate()?;
         let slots = self.nodes.slot_count();
@@ -29,9 +30,10 @@ impl<T> LooseKdTree<T> {
             }
             *seen = true;
         }
-        if self.spare.iter().any(|v| !v.is_empty()) {
-            return fail("a spare object vector is not empty".into());
+        if self.store.sphere.len() != self.store.entry.len() {
+            return fail("object array columns differ in length".into());
         }
+        let mut owned = vec![false; self.store.len()];
         if !self.span.contains_aabb(&self.world) || self.eps != slack(&self.span) {
             return fail("span does not cover the world or eps is stale".into());
         }
@@ -93,8 +95,23 @@ impl<T> LooseKdTree<T> {
             }
             // Objects: each one's handle is live and locates exactly this slot,
             // and it sits where the placement rule puts it.
-            for (pos, slot) in node.slots.iter().enumerate() {
-                match self.items.get(slot.handle) {
+            let (start, cap) = (node.start as usize, node.cap as usize);
+            if node.len > node.cap || start + cap > owned.len() {
+                return fail(format!("node {n}: range out of the array or overfull"));
+            }
+            for (p, o) in owned.iter_mut().enumerate().skip(start).take(cap) {
+                if std::mem::replace(o, true) {
+                    return fail(format!("node {n}: range overlaps another"));
+                }
+                if p >= start + node.len as usize && self.store.entry[p].is_some() {
+                    return fail(format!("node {n}: spare position {p} not empty"));
+                }
+            }
+            for (pos, p) in node.range().enumerate() {
+                let Some((handle, _)) = &self.store.entry[p] else {
+                    return fail(format!("node {n}: live position {p} empty"));
+                };
+                match self.items.get(*handle) {
                     Ok(loc) if loc.node == n && loc.pos as usize == pos => {}
                     _ => {
                         return fail(format!(
@@ -102,7 +119,7 @@ impl<T> LooseKdTree<T> {
                         ))
                     }
                 }
-                let s = &slot.sphere;
+                let s = &self.store.sphere[p];
                 let here = s.radius >= node.h || node.depth >= self.max_depth;
                 if !node.routes(s) || !here {
                     return fail(format!(
@@ -114,7 +131,7 @@ impl<T> LooseKdTree<T> {
                     return fail(format!("object in node {n} outside span"));
                 }
             }
-            items_seen += node.slots.len();
+            items_seen += node.len as usize;
             for c in node.child {
                 if c != NIL {
                     if (c as usize) >= slots || free[c as usize] || self.nodes[c].parent != n {
@@ -135,6 +152,18 @@ impl<T> LooseKdTree<T> {
                 "{items_seen} objects in nodes but {} stored",
                 self.items.len()
             ));
+        }
+        let dead = owned.iter().filter(|&&o| !o).count();
+        if dead != self.store.dead {
+            return fail(format!(
+                "{dead} dead positions but {} counted",
+                self.store.dead
+            ));
+        }
+        for (p, o) in owned.iter().enumerate() {
+            if !o && self.store.entry[p].is_some() {
+                return fail(format!("dead position {p} not empty"));
+            }
         }
         Ok(())
     }

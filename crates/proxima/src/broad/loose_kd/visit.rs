@@ -54,7 +54,7 @@ impl<T> LooseKdTree<T> {
                 axis: node.axis as usize,
                 mid: node.m,
                 half_width: node.h,
-                items: node.slots.len(),
+                items: node.len as usize,
                 children: [node.child[0] != NIL, node.child[1] != NIL],
             });
             // Positive pushed first so the negative child is visited first.

@@ -26,6 +26,7 @@ use crate::workloads::{cube_side, Kind, Workload};
 use engine::{Engine, Proxima};
 use proxima::broad::{
     loose_kd, BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, UniformGrid2d,
+    UniformGrid3d,
 };
 use queries::QueryKind;
 use std::fmt::Write;
@@ -174,6 +175,15 @@ fn entries() -> Vec<Entry> {
             quadratic: false,
             build: |s, sc, m| {
                 let t = HashGrid::new(sc.r_max).expect("grid params");
+                Box::new(Proxima::build(t, s, &order(s, m)))
+            },
+        },
+        Entry {
+            name: "UniformGrid3d",
+            peer: false,
+            quadratic: false,
+            build: |s, sc, m| {
+                let t = UniformGrid3d::new(sc.world, sc.r_max).expect("grid params");
                 Box::new(Proxima::build(t, s, &order(s, m)))
             },
         },

@@ -1,13 +1,15 @@
 //! `triangles_intersect` against the exact reference of the test suite (built
 //! from the `robust` predicates with a different decomposition), and its
-//! invariance under argument order and vertex order.
+//! invariance under argument order and vertex order; and the prepared path used by
+//! the BVH collision queries (`narrow::PreparedTriangle::intersects`, an `f64`
+//! filter in front of the exact test) against the same reference.
 #![no_main]
 
 #[path = "../../crates/proxima/tests/tri_tri/reference.rs"]
 mod reference;
 
 use proxima::glam::Vec3;
-use proxima::narrow::triangles_intersect;
+use proxima::narrow::{triangles_intersect, PreparedTriangle};
 
 /// Coordinates on a small integer grid (many exact touches and coplanar cases)
 /// or raw finite floats.
@@ -50,4 +52,9 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     let ra = [a[1], a[2], a[0]];
     let fb = [b[2], b[1], b[0]];
     assert_eq!(triangles_intersect(&ra, &fb), want, "reordered {a:?} {b:?}");
+    let (pa, pb) = (PreparedTriangle::new(a), PreparedTriangle::new(b));
+    assert_eq!(pa.intersects(&pb), want, "prepared {a:?} {b:?}");
+    assert_eq!(pb.intersects(&pa), want, "prepared swapped {a:?} {b:?}");
+    let (pra, pfb) = (PreparedTriangle::new(ra), PreparedTriangle::new(fb));
+    assert_eq!(pra.intersects(&pfb), want, "prepared reordered {a:?} {b:?}");
 });

@@ -582,3 +582,100 @@ fn hash_grid_pairs_oversized_far_point() {
     assert_eq!(g.pairs().len(), 1, "the grid misses the pair");
     g.validate().unwrap();
 }
+
+/// `found/index_ops-grid2d-far-segment`: a segment from (-15.5, 3e38) to
+/// (-f32::MAX, 0) ends inside a ball of radius 1.01e31 (half an ulp there) at x = -f32::MAX (referenced
+/// from the border column of a ±16 world). The 2D grid's strip walk must report
+/// it at t = 1 like brute force.
+#[test]
+fn grid2d_far_segment_end_hit() {
+    let w = Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0));
+    let ball = Sphere::new(vec3(-f32::MAX, -32.0, 0.0), 1.0141205e31);
+    let seg = Segment::new(vec3(-15.5, 3e38, -32.0), vec3(-f32::MAX, 0.0, -32.0));
+    let ray = seg.to_ray();
+    assert_eq!(overlap::ray_sphere(&ray, &ball), Some(1.0));
+    for cell in [0.5, 0.25, 1.0, 2.0, 4.0, 8.0] {
+        let mut g = UniformGrid2d::with_cell_size(w, cell).unwrap();
+        g.insert(ball, 0u32).unwrap();
+        g.insert(Sphere::new(Vec3::splat(-32.0), 0.0), 1).unwrap();
+        assert_eq!(g.ray_hits(&ray).unwrap().len(), 1, "cell {cell}: ray_hits");
+        assert_eq!(
+            g.ray_first(&ray).unwrap().map(|h| h.t),
+            Some(1.0),
+            "cell {cell}: ray_first"
+        );
+    }
+}
+
+/// The same class for the other grids: balls whose bounds overflow to ±∞ (a half
+/// ulp beyond `f32::MAX`) or nearly, at the world's corners and far outside, hit by
+/// segments and rays from inside; every grid agrees with brute force.
+#[test]
+fn grids_far_balls_near_overflow_match_brute_force() {
+    let w = Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0));
+    let mut hits = 0;
+    for cell in [0.5, 4.0] {
+        hits += far_rays_agree(UniformGrid2d::with_cell_size(w, cell).unwrap());
+        hits += far_rays_agree(UniformGrid3d::with_cell_size(w, cell).unwrap());
+        hits += far_rays_agree(HashGrid::with_cell_size(cell).unwrap());
+    }
+    assert!(hits > 100, "the scene must produce hits ({hits})");
+}
+
+/// Inserts the near-overflow scene into `i` and compares rays and segments between
+/// its points with brute force; returns the number of hits.
+fn far_rays_agree<I: SpatialIndex<u32>>(mut i: I) -> usize {
+    let m = f32::MAX;
+    let balls = [
+        Sphere::new(vec3(-m, -32.0, 0.0), 1.0141205e31),
+        Sphere::new(vec3(m, 32.0, -5.0), 1.0141205e31),
+        Sphere::new(vec3(0.0, -m, 3.0), 2e31),
+        Sphere::new(vec3(-3e38, 3e38, 0.0), 1e31),
+        Sphere::new(vec3(5.0, 5.0, m), 1.0141205e31),
+        Sphere::new(Vec3::splat(-32.0), 0.0),
+        Sphere::new(vec3(1.0, 2.0, 3.0), 0.5),
+    ];
+    let ends = [
+        vec3(-m, 0.0, -32.0),
+        vec3(-15.5, 3e38, -32.0),
+        vec3(m, 32.0, -5.0),
+        vec3(0.0, -m, 3.0),
+        vec3(-3e38, 3e38, 0.0),
+        vec3(5.0, 5.0, m),
+        vec3(1.0, 2.0, 3.0),
+        vec3(-15.5, 0.25, 0.0),
+    ];
+    let mut b = BruteForce::new();
+    for (k, s) in balls.iter().enumerate() {
+        b.insert(*s, k as u32).unwrap();
+        i.insert(*s, k as u32).unwrap();
+    }
+    fn key<J: SpatialIndex<u32>>(j: &J, v: &[proxima::broad::RayHit]) -> Vec<(u32, u32)> {
+        let mut v: Vec<_> = v
+            .iter()
+            .map(|h| (*j.get(h.handle).unwrap().1, h.t.to_bits()))
+            .collect();
+        v.sort();
+        v
+    }
+    let mut hits = 0;
+    for &p in &ends {
+        for &q in &ends {
+            for ray in [Segment::new(p, q).to_ray(), Ray::new(p, q - p)] {
+                if ray.validate().is_err() {
+                    continue;
+                }
+                let want = key(&b, &b.ray_hits(&ray).unwrap());
+                hits += want.len();
+                assert_eq!(key(&i, &i.ray_hits(&ray).unwrap()), want, "{ray:?}");
+                let first = |j: Option<proxima::broad::RayHit>| j.map(|h| h.t.to_bits());
+                assert_eq!(
+                    first(i.ray_first(&ray).unwrap()),
+                    first(b.ray_first(&ray).unwrap()),
+                    "{ray:?}"
+                );
+            }
+        }
+    }
+    hits
+}

@@ -158,7 +158,10 @@ impl Geometry {
     /// the centre's magnitude, not to the bound's (a ball at y = -3e38 of radius
     /// 3e38 has `c + r = 0` but the exact test may accept y = 11.5).
     pub fn sphere_rect(&self, s: &Sphere) -> CellRect {
-        let e = |c: f32| (c.abs() + s.radius) * REL_PAD;
+        // Two products, not `(|c| + r) · REL_PAD`: that sum overflows to ∞ for a ball
+        // at -f32::MAX of radius 1e31, and an infinite pad referenced it from every
+        // cell, outside the loose boxes the ray walk's once-only rule relies on.
+        let e = |c: f32| c.abs() * REL_PAD + s.radius * REL_PAD;
         let (cx, cy) = (s.center.x, s.center.y);
         let (x0, x1) = self.span(cx - s.radius - e(cx), cx + s.radius + e(cx), 0);
         let (y0, y1) = self.span(cy - s.radius - e(cy), cy + s.radius + e(cy), 1);
@@ -178,8 +181,10 @@ impl Geometry {
     /// computed with other roundings would reject).
     #[inline]
     pub fn padded(&self, b: &Aabb) -> Aabb {
+        // 3× the relative pad: a footprint is padded twice (`sphere_rect`, then
+        // `span`), so an object may be referenced from a cell that far from it.
         let m = b.min.abs().max(b.max.abs()).max_element();
-        b.grown(self.pad + m * REL_PAD)
+        b.grown(self.pad + m * (3.0 * REL_PAD))
     }
 
     /// Every cell.

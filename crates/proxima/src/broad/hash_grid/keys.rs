@@ -156,7 +156,8 @@ impl Keys {
     ///
     /// Padded relative to `|centre| + radius` too (see the 2D grid's `sphere_rect`).
     pub fn sphere_box(&self, s: &Sphere) -> KeyBox {
-        let e = (s.center.abs() + glam::Vec3::splat(s.radius)) * REL_PAD;
+        // Two products: the sum `|c| + r` may overflow to ∞ (see the 2D grid).
+        let e = s.center.abs() * REL_PAD + glam::Vec3::splat(s.radius * REL_PAD);
         let r = glam::Vec3::splat(s.radius);
         self.aabb_box(&Aabb::new(s.center - r - e, s.center + r + e))
     }

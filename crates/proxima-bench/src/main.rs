@@ -13,7 +13,7 @@
 
 use proxima_bench::registry::{self, QUADRATIC_LIMIT};
 use proxima_bench::report;
-use proxima_bench::run::{measure_all_threads, Clock};
+use proxima_bench::run::{measure_all_threads, num, Clock};
 use proxima_bench::workloads::Kind;
 use std::process::ExitCode;
 
@@ -57,13 +57,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                     .map(String::from)
                     .collect()
             }
-            "--clock" => {
-                a.clock = match value("--clock")?.as_str() {
-                    "cpu" => Clock::ThreadCpu,
-                    "wall" => Clock::Wall,
-                    other => return Err(format!("--clock takes cpu or wall, not {other:?}")),
-                }
-            }
+            "--clock" => a.clock = Clock::parse(&value("--clock")?)?,
             "--threads" => a.threads = num(&value("--threads")?)?,
             "--json" => a.json = true,
             "-h" | "--help" => return Err(String::new()),
@@ -81,12 +75,6 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         a.clock = Clock::Wall;
     }
     Ok(a)
-}
-
-fn num<T: std::str::FromStr>(s: &str) -> Result<T, String> {
-    s.replace('_', "")
-        .parse()
-        .map_err(|_| format!("not a number: {s:?}"))
 }
 
 fn main() -> ExitCode {

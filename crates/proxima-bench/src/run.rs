@@ -17,7 +17,24 @@ pub enum Clock {
     ThreadCpu,
 }
 
+/// A command-line number (`100_000` allowed), for every workload's arguments.
+pub fn num<T: std::str::FromStr>(s: &str) -> Result<T, String> {
+    s.replace('_', "")
+        .parse()
+        .map_err(|_| format!("not a number: {s:?}"))
+}
+
 impl Clock {
+    /// The clock named by a `--clock` value (`cpu` or `wall`); the error is the
+    /// message every workload prints.
+    pub fn parse(s: &str) -> Result<Clock, String> {
+        match s {
+            "cpu" => Ok(Clock::ThreadCpu),
+            "wall" => Ok(Clock::Wall),
+            other => Err(format!("--clock takes cpu or wall, not {other:?}")),
+        }
+    }
+
     /// `wall` or `cpu`.
     pub fn name(self) -> &'static str {
         match self {

@@ -21,7 +21,7 @@ pub mod queries;
 pub mod rstar_peer;
 
 use crate::registry::QUADRATIC_LIMIT;
-use crate::run::{median, Clock};
+use crate::run::{median, num, Clock};
 use crate::workloads::{cube_side, Kind, Workload};
 use engine::{Engine, Proxima};
 use proxima::broad::{
@@ -60,12 +60,6 @@ pub struct Args {
     pub morton: bool,
 }
 
-fn num<T: std::str::FromStr>(s: &str) -> Result<T, String> {
-    s.replace('_', "")
-        .parse()
-        .map_err(|_| format!("not a number: {s:?}"))
-}
-
 /// Parses the arguments after `w4`.
 pub fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     let mut a = Args {
@@ -89,13 +83,7 @@ pub fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--reps" => a.reps = num(&value("--reps")?)?,
             "--threads" => a.threads = num(&value("--threads")?)?,
             "--seed" => a.seed = num(&value("--seed")?)?,
-            "--clock" => {
-                a.clock = match value("--clock")?.as_str() {
-                    "cpu" => Clock::ThreadCpu,
-                    "wall" => Clock::Wall,
-                    other => return Err(format!("--clock takes cpu or wall, not {other:?}")),
-                }
-            }
+            "--clock" => a.clock = Clock::parse(&value("--clock")?)?,
             "--json" => a.json = true,
             "--order" => {
                 a.morton = match value("--order")?.as_str() {

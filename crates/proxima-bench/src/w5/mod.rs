@@ -109,13 +109,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                     }
                 }
             }
-            "--clock" => {
-                a.clock = match value("--clock")?.as_str() {
-                    "cpu" => Clock::ThreadCpu,
-                    "wall" => Clock::Wall,
-                    o => return Err(format!("--clock takes cpu or wall, not {o:?}")),
-                }
-            }
+            "--clock" => a.clock = Clock::parse(&value("--clock")?)?,
             "--json" => a.json = true,
             "-h" | "--help" => return Err(String::new()),
             o => return Err(format!("unknown argument {o:?}")),

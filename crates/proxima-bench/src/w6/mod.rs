@@ -15,7 +15,7 @@ pub mod check;
 pub mod rays;
 pub mod structures;
 
-use crate::run::{median, Clock};
+use crate::run::{median, num, Clock};
 use check::{Verdict, Verifier};
 use proxima::geom::Ray;
 use proxima::narrow::{BuildOptions, SplitRule, TriMesh};
@@ -57,12 +57,6 @@ fn list(s: &str) -> Vec<String> {
         .collect()
 }
 
-fn num<T: std::str::FromStr>(s: &str) -> Result<T, String> {
-    s.replace('_', "")
-        .parse()
-        .map_err(|_| format!("not a number: {s:?}"))
-}
-
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     let mut a = Args {
         meshes: MESHES.iter().map(|s| s.to_string()).collect(),
@@ -90,13 +84,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--leaf" => a.leaf = num(&value("--leaf")?)?,
             "--seed" => a.seed = num(&value("--seed")?)?,
             "--only" => a.only = list(&value("--only")?),
-            "--clock" => {
-                a.clock = match value("--clock")?.as_str() {
-                    "cpu" => Clock::ThreadCpu,
-                    "wall" => Clock::Wall,
-                    o => return Err(format!("--clock takes cpu or wall, not {o:?}")),
-                }
-            }
+            "--clock" => a.clock = Clock::parse(&value("--clock")?)?,
             "--json" => a.json = true,
             "-h" | "--help" => return Err(String::new()),
             o => return Err(format!("unknown argument {o:?}")),

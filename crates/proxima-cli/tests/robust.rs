@@ -71,6 +71,19 @@ fn replay_octree_world_center_overflow() {
     assert_eq!(out.stdout, "sphere 0\npairs 0\n");
 }
 
+/// Found by the replay fuzzer: a radius near f32::MAX and a world wider than
+/// f32's range. Every grid used to refuse the scene (cell size 2r or the world's
+/// extent overflowed to ∞); now each one takes it and agrees with brute force.
+#[test]
+fn replay_radius_near_f32_max_every_index_accepts() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fuzz/found/replay-radius-near-f32-max"
+    );
+    let out = proxima(&["replay", path, "--index", "all", "--check"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+}
+
 /// Objects at ±1e30 with radii up to 1e30: every index agrees with brute force.
 #[test]
 fn replay_extreme_coordinates_all_indices_agree() {

@@ -74,7 +74,11 @@ impl Geometry {
         }
         let mut dims = [0u32; 2];
         for (a, d) in dims.iter_mut().enumerate() {
-            let n = ((world.max[a] - world.min[a]) / cell).ceil().max(1.0);
+            // In f64: a world spanning most of the f32 range has an extent that
+            // overflows f32 (3e38 - -3e38), yet a huge cell covers it.
+            let n = ((world.max[a] as f64 - world.min[a] as f64) / cell as f64)
+                .ceil()
+                .max(1.0) as f32;
             if n.is_nan() || n > MAX_CELLS_PER_AXIS as f32 {
                 return Err(Error::InvalidParameter(format!(
                     "grid would need {n} cells along an axis (at most {MAX_CELLS_PER_AXIS})"

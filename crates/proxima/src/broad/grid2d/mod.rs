@@ -115,16 +115,20 @@ impl<T> UniformGrid2d<T> {
     /// holds few objects), enlarged if the rectangle would need more than 2^20
     /// cells. A zero radius gives 1/256 of the longer side.
     pub fn default_cell_size(world: &Aabb, typical_radius: f32) -> f32 {
-        let e = world.extent();
-        let side = e.x.max(e.y);
-        let mut cell = 2.0 * typical_radius;
+        // In f64 and clamped to f32::MAX: a world spanning most of the f32 range
+        // has an extent that overflows f32, and `2 r` can too.
+        let ex = world.max.x as f64 - world.min.x as f64;
+        let ey = world.max.y as f64 - world.min.y as f64;
+        let side = ex.max(ey);
+        let mut cell = 2.0 * typical_radius as f64;
         if cell.is_nan() || cell <= 0.0 {
             cell = if side > 0.0 { side / 256.0 } else { 1.0 };
         }
-        let min_for_cap = ((e.x as f64 * e.y as f64) / DEFAULT_MAX_CELLS as f64).sqrt() as f32;
+        let min_for_cap = ((ex * ey) / DEFAULT_MAX_CELLS as f64).sqrt();
         // Also keep each axis within its limit.
-        let min_for_axis = side / (cells::MAX_CELLS_PER_AXIS as f32 - 1.0);
-        cell.max(min_for_cap * 1.001).max(min_for_axis)
+        let min_for_axis = side / (cells::MAX_CELLS_PER_AXIS as f64 - 1.0);
+        let cell = cell.max(min_for_cap * 1.001).max(min_for_axis * 1.001);
+        (cell as f32).min(f32::MAX)
     }
 
     /// Edge of a cell.

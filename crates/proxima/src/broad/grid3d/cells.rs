@@ -56,12 +56,12 @@ impl Geometry {
                 "grid cell size {cell} must be finite and positive"
             )));
         }
-        let e = world.extent();
-        if !e.is_finite() {
-            return Err(Error::InvalidParameter(format!(
-                "world box {world:?} is too large for a dense grid"
-            )));
-        }
+        // A world spanning most of the f32 range has an extent that overflows
+        // f32: clamp it. The grid then ends before the world does, and centres
+        // beyond it go to the border cells like any centre outside the world.
+        let e = (world.max.as_dvec3() - world.min.as_dvec3())
+            .min(glam::DVec3::splat(f32::MAX as f64))
+            .as_vec3();
         let mut cell = cell;
         // Enlarge the cells until both caps hold (a few iterations at most).
         let dims = loop {

@@ -88,7 +88,7 @@ impl<T> UniformGrid3d<T> {
                 "typical radius {typical_radius} must be finite and positive"
             )));
         }
-        Self::with_cell_size(world, typical_radius / cells::GRID_FRACTION)
+        Self::with_cell_size(world, (typical_radius / cells::GRID_FRACTION).min(f32::MAX))
     }
 
     /// A grid over `world` with cubic cells of edge `cell_size` (or larger, if the

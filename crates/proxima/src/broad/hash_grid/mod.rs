@@ -140,7 +140,8 @@ impl<T> HashGrid<T> {
                 "typical radius {typical_radius} must be finite and positive"
             )));
         }
-        Self::with_cell_size(2.0 * typical_radius)
+        // `2 r` overflows above f32::MAX / 2: the largest cell then.
+        Self::with_cell_size((2.0 * typical_radius).min(f32::MAX))
     }
 
     /// A grid with cubic cells of edge `cell_size`. Errors unless it is finite,

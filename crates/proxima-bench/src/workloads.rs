@@ -101,7 +101,7 @@ fn gaussian(rng: &mut Pcg64) -> f32 {
 }
 
 /// A uniformly random unit vector (rejection sampling in the unit ball).
-fn unit_vector(rng: &mut Pcg64) -> Vec3 {
+pub fn unit_vector(rng: &mut Pcg64) -> Vec3 {
     loop {
         let v = Vec3::new(
             rng.gen_range(-1.0..1.0),

@@ -82,20 +82,6 @@ fn point(rng: &mut Pcg64, side: f32) -> Vec3 {
     )
 }
 
-fn direction(rng: &mut Pcg64) -> Vec3 {
-    loop {
-        let v = Vec3::new(
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-        );
-        let l2 = v.length_squared();
-        if l2 > 1e-4 && l2 <= 1.0 {
-            return v / l2.sqrt();
-        }
-    }
-}
-
 /// `q` queries of each point kind and `frusta` frusta over the W1 cube of side
 /// `side`, from `seed`.
 pub fn generate(side: f32, q: usize, frusta: usize, seed: u64) -> Batches {
@@ -119,7 +105,10 @@ pub fn generate(side: f32, q: usize, frusta: usize, seed: u64) -> Batches {
         .collect();
     let rays = (0..q)
         .map(|i| {
-            let (o, d) = (point(&mut rng, side), direction(&mut rng));
+            let (o, d) = (
+                point(&mut rng, side),
+                crate::workloads::unit_vector(&mut rng),
+            );
             if i % 2 == 0 {
                 Ray::with_max_t(o, d, rng.gen_range(5.0..=20.0))
             } else {

@@ -87,7 +87,9 @@ pub fn entries() -> Vec<Entry> {
         )),
         proxima!("UniformGrid2d", |s| UniformGrid2d::new(s.world, s.r_max)),
         proxima!("HashGrid", |s| HashGrid::new(s.r_max)),
-        proxima!("UniformGrid3d", |s| UniformGrid3d::new(s.world, s.r_max)),
+        proxima!("UniformGrid3d", parallel, |s| UniformGrid3d::new(
+            s.world, s.r_max
+        )),
         Entry {
             name: PARRY,
             quadratic: false,

@@ -35,7 +35,10 @@ pub struct ParryMeshes {
     b: PTriMesh,
 }
 
-fn convert(m: &TriMesh) -> Result<PTriMesh, String> {
+/// Our mesh as a parry `TriMesh` (vertex copy, then parry's own BVH build;
+/// default flags: no vertex merging, no degenerate removal). Shared by the W5
+/// and W6 peers.
+pub fn convert(m: &TriMesh) -> Result<PTriMesh, String> {
     let v = m
         .vertices()
         .iter()

@@ -20,14 +20,12 @@ pub struct ParryMesh {
 }
 
 impl ParryMesh {
-    /// `TriMesh::new` (default flags: no vertex merging, no degenerate removal).
-    pub fn build(mesh: &TriMesh) -> Self {
-        let vs = mesh.vertices().iter().map(|&p| v(p)).collect();
-        let m = PTriMesh::new(vs, mesh.triangles().to_vec()).expect("valid mesh");
-        ParryMesh {
-            mesh: m,
+    /// [`crate::parry_mesh::convert`] (the same conversion as the W5 peer).
+    pub fn build(mesh: &TriMesh) -> Result<Self, String> {
+        Ok(ParryMesh {
+            mesh: crate::parry_mesh::convert(mesh)?,
             n: mesh.len() as u32,
-        }
+        })
     }
 }
 

@@ -136,7 +136,7 @@ pub fn entries() -> Vec<Entry> {
         e(OBVHS, true, false, |m, _| Box::new(Obvhs::build(m))),
         e("bvh", true, false, |m, _| Box::new(BvhCrate::build(m))),
         e("parry3d-trimesh", true, false, |m, _| {
-            Box::new(ParryMesh::build(m))
+            Box::new(ParryMesh::build(m).expect("valid mesh"))
         }),
     ]
 }

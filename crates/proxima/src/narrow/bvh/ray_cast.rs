@@ -182,6 +182,9 @@ impl RayBvh {
                         continue;
                     }
                     // Entered lanes sorted by entry t (at most four: insertion).
+                    // Lanes read from an array: indexing a Vec4 by a variable
+                    // compiles to a jump table (an indirect branch per read).
+                    let near = near.to_array();
                     let mut hits = [(n.child[first], near[first]); 4];
                     let mut k = 1;
                     while mask != 0 {
@@ -265,6 +268,7 @@ impl RayBvh {
     ) -> bool {
         // Lanes by estimate (at most four: insertion; NaN estimates compare
         // false and stay where they are).
+        let est = est.to_array();
         let mut cand = [(0u32, 0f32); 4];
         let mut nc = 0;
         while mask != 0 {

@@ -181,10 +181,21 @@ impl RayBvh {
                         cur = n.child[first];
                         continue;
                     }
-                    // Entered lanes sorted by entry t (at most four: insertion).
                     // Lanes read from an array: indexing a Vec4 by a variable
                     // compiles to a jump table (an indirect branch per read).
                     let near = near.to_array();
+                    let second = mask.trailing_zeros() as usize;
+                    if mask & (mask - 1) == 0 {
+                        // Two lanes (the common multi-lane case): the nearer
+                        // next, the other stacked, chosen without a branch.
+                        let (a, b) = (first, second);
+                        let swap = near[b] < near[a];
+                        let (a, b) = if swap { (b, a) } else { (a, b) };
+                        stack.push((n.child[b], near[b]));
+                        cur = n.child[a];
+                        continue;
+                    }
+                    // Entered lanes sorted by entry t (at most four: insertion).
                     let mut hits = [(n.child[first], near[first]); 4];
                     let mut k = 1;
                     while mask != 0 {

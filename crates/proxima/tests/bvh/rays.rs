@@ -209,6 +209,88 @@ fn rays_procedural() {
     check_mesh(&uv_sphere(Vec3::ZERO, 1.5, 12, 8), 1500, 7);
 }
 
+/// A random soup of `n` triangles in a cube of side 100: axis-aligned quads of
+/// every size (two triangles sharing a diagonal, walls like `env.obj`'s), thin
+/// slivers, small random triangles, and repeated and degenerate ones, so that
+/// leaves of the SAH plan hold overlapping boxes, several triangles one ray
+/// crosses, and shared edges.
+fn soup(n: usize, seed: u64) -> TriMesh {
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let mut v: Vec<Vec3> = Vec::new();
+    let mut t: Vec<[u32; 3]> = Vec::new();
+    let p = |rng: &mut Pcg64| {
+        Vec3::new(
+            rng.gen_range(-50.0..50.0f32).round(),
+            rng.gen_range(-50.0..50.0f32).round(),
+            rng.gen_range(-50.0..50.0f32).round(),
+        )
+    };
+    while t.len() < n {
+        let b = v.len() as u32;
+        match rng.gen_range(0..5) {
+            0 | 1 => {
+                let axis = rng.gen_range(0..3);
+                let (a, c) = (p(&mut rng), p(&mut rng));
+                let mut q = [a, a, c, c];
+                q[1][(axis + 1) % 3] = c[(axis + 1) % 3];
+                q[3][(axis + 1) % 3] = a[(axis + 1) % 3];
+                for x in &mut q {
+                    x[axis] = a[axis];
+                }
+                v.extend(q);
+                t.push([b, b + 1, b + 2]);
+                t.push([b, b + 2, b + 3]);
+            }
+            2 => {
+                let a = p(&mut rng);
+                v.extend([a, p(&mut rng), a + Vec3::splat(0.01)]);
+                t.push([b, b + 1, b + 2]);
+            }
+            3 => {
+                let a = p(&mut rng);
+                let s = rng.gen_range(0.1..5.0f32);
+                v.extend([a, a + Vec3::X * s, a + Vec3::new(0.3, 0.7, -0.2) * s]);
+                t.push([b, b + 1, b + 2]);
+            }
+            _ => {
+                // A copy of an earlier triangle, or a degenerate one.
+                if let Some(&old) = t.get(rng.gen_range(0..t.len().max(1))) {
+                    t.push(old);
+                } else {
+                    let a = p(&mut rng);
+                    v.extend([a, a, a]);
+                    t.push([b, b + 1, b + 2]);
+                }
+            }
+        }
+    }
+    TriMesh::new(v, t).unwrap()
+}
+
+/// [`RayBvh`] (its SAH leaf plan, every leaf size up to two packets and more)
+/// against brute force on random soups, rays of the whole mix (grazing vertices
+/// and edges, in-plane, axis-parallel, bounded).
+#[test]
+fn ray_bvh_random_soups_match_brute_force() {
+    for seed in 0..6 {
+        let m = soup(40 + 60 * seed as usize, 100 + seed);
+        let rays = ray_mix(&m, 600, 200 + seed);
+        let wants: Vec<_> = rays.iter().map(|r| brute(&m, r)).collect();
+        let hits = wants.iter().filter(|w| w.is_some()).count();
+        assert!(hits > 100, "{hits} hits");
+        for split in [SplitRule::Sah, SplitRule::Median] {
+            for leaf in [1, 2, 3, 4, 5, 7, 9] {
+                let o = BuildOptions {
+                    split,
+                    leaf_size: leaf,
+                };
+                let t = RayBvh::build(&m, o).unwrap();
+                check_ray_bvh(&m, &t, &rays, &wants, &format!("soup {seed} {o:?}"));
+            }
+        }
+    }
+}
+
 /// Deform, refit, and compare again.
 #[test]
 fn ray_bvh_refit_matches_brute_force() {

@@ -16,25 +16,28 @@ const WIDEN: f32 = 4.0 * f32::EPSILON;
 const STACK: usize = 16;
 
 /// A LIFO of `(node, entry t)` on the machine stack, spilling to the heap only for
-/// trees deeper than [`STACK`].
+/// trees deeper than [`STACK`]. Items are packed in a `u64` (node in the low half,
+/// the bits of `t` in the high half) so that creating the stack, once per ray,
+/// is a few vector stores rather than one store per field.
 pub(crate) struct Stack {
-    items: [(u32, f32); STACK],
+    items: [u64; STACK],
     len: usize,
-    spill: Vec<(u32, f32)>,
+    spill: Vec<u64>,
 }
 
 impl Stack {
     #[inline(always)]
     pub(crate) fn new() -> Stack {
         Stack {
-            items: [(0, 0.0); STACK],
+            items: [0; STACK],
             len: 0,
             spill: Vec::new(),
         }
     }
 
     #[inline(always)]
-    pub(crate) fn push(&mut self, x: (u32, f32)) {
+    pub(crate) fn push(&mut self, (i, t): (u32, f32)) {
+        let x = i as u64 | (t.to_bits() as u64) << 32;
         if self.len < STACK {
             self.items[self.len] = x;
             self.len += 1;
@@ -45,43 +48,42 @@ impl Stack {
 
     #[inline(always)]
     pub(crate) fn pop(&mut self) -> Option<(u32, f32)> {
-        if let Some(x) = self.spill.pop() {
-            return Some(x);
-        }
-        if self.len == 0 {
-            return None;
-        }
-        self.len -= 1;
-        Some(self.items[self.len])
+        let x = match self.spill.pop() {
+            Some(x) => x,
+            None if self.len == 0 => return None,
+            None => {
+                self.len -= 1;
+                self.items[self.len]
+            }
+        };
+        Some((x as u32, f32::from_bits((x >> 32) as u32)))
     }
 }
 
 /// The ray in the form the 4-wide slab test wants: origin and inverse direction
-/// splatted per axis, and which side of each slab the ray enters by.
+/// splatted per axis.
 struct Slabs {
     o: [Vec4; 3],
     inv: [Vec4; 3],
-    /// `neg[a]`: the direction is negative on axis `a` (enters by the max side).
-    neg: [bool; 3],
 }
 
 /// Entry parameters of the ray into the four lanes of `n` and the mask of lanes it
 /// enters at or before `limit`: slab test with the precomputed inverse direction
-/// (all finite) and the near/far side of each slab chosen once per ray by the
-/// direction's signs, the interval widened by [`WIDEN`] so rounding never culls a
-/// box the ray touches. Only vertical SIMD operations.
+/// (all finite), each slab's near side the min of its two crossings, the interval
+/// widened by [`WIDEN`] so rounding never culls a box the ray touches. Only
+/// vertical SIMD operations.
 #[inline(always)]
 fn entry4(n: &RayNode, s: &Slabs, limit: f32) -> (Vec4, u32) {
     let mut near = Vec4::ZERO;
     let mut far = Vec4::splat(limit);
     for a in 0..3 {
-        let (np, fp) = if s.neg[a] {
-            (n.hi[a], n.lo[a])
-        } else {
-            (n.lo[a], n.hi[a])
-        };
-        near = near.max((np - s.o[a]) * s.inv[a]);
-        far = far.min((fp - s.o[a]) * s.inv[a]);
+        // Both sides, then min/max: cheaper than selecting the near side per
+        // node, and the same values (rounding is monotonic, so the side nearer
+        // in exact arithmetic stays nearer or equal).
+        let t0 = (n.b[0][a] - s.o[a]) * s.inv[a];
+        let t1 = (n.b[1][a] - s.o[a]) * s.inv[a];
+        near = near.max(t0.min(t1));
+        far = far.min(t0.max(t1));
     }
     let near = near * (1.0 - WIDEN);
     // `limit` was in `far` before widening: a box entered exactly at the best
@@ -142,7 +144,6 @@ impl RayBvh {
             let s = Slabs {
                 o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
                 inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
-                neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
             };
             self.traverse(ray, any, |n, limit| entry4(n, &s, limit))
         } else {
@@ -180,6 +181,20 @@ impl RayBvh {
                         cur = n.child[first];
                         continue;
                     }
+                    // Lanes read from an array: indexing a Vec4 by a variable
+                    // compiles to a jump table (an indirect branch per read).
+                    let near = near.to_array();
+                    let second = mask.trailing_zeros() as usize;
+                    if mask & (mask - 1) == 0 {
+                        // Two lanes (the common multi-lane case): the nearer
+                        // next, the other stacked, chosen without a branch.
+                        let (a, b) = (first, second);
+                        let swap = near[b] < near[a];
+                        let (a, b) = if swap { (b, a) } else { (a, b) };
+                        stack.push((n.child[b], near[b]));
+                        cur = n.child[a];
+                        continue;
+                    }
                     // Entered lanes sorted by entry t (at most four: insertion).
                     let mut hits = [(n.child[first], near[first]); 4];
                     let mut k = 1;
@@ -202,31 +217,31 @@ impl RayBvh {
                     continue;
                 }
             } else {
-                let [s, count] = self.leaves[(cur & !LEAF) as usize];
-                for k in s as usize..(s + count) as usize {
-                    let t = &self.tris[k];
-                    let e1 = t.v[0] - t.v[1];
-                    let e2 = t.v[2] - t.v[0];
-                    if !filter.may_hit(t.v[0], e1, e2, Vec3A::from_vec4(t.ng), t.ng.w, limit) {
+                let [s, count, first] = self.leaves[(cur & !LEAF) as usize];
+                // Four triangles per pre-test, then the exact test on the
+                // survivors nearest first: a leaf often holds several triangles
+                // the ray crosses (both faces of a thin wall), and once the near
+                // one is hit the far ones fail the pre-test against the new limit.
+                for q in 0..count.div_ceil(4) {
+                    let lanes = (count - 4 * q).min(4);
+                    let (mask, est) = filter.may_hit4(&self.packets[(first + q) as usize], limit);
+                    let mask = mask & ((1 << lanes) - 1);
+                    if mask == 0 {
                         continue;
                     }
-                    let w = woop.get_or_insert_with(|| WoopRay::new(ray));
-                    let Some(h) = w.hit(&[t.v[0].into(), t.v[1].into(), t.v[2].into()]) else {
-                        continue;
-                    };
-                    let id = self.ids[k];
-                    if best.map_or(true, |b| h.t < b.t || (h.t == b.t && id < b.triangle)) {
-                        best = Some(RayHit {
-                            triangle: id,
-                            t: h.t,
-                            u: h.u,
-                            v: h.v,
-                        });
-                        if any {
-                            return best;
-                        }
-                        limit = h.t;
+                    if self.exact_tests(
+                        s + 4 * q,
+                        mask,
+                        est,
+                        &filter,
+                        ray,
+                        &mut woop,
+                        &mut best,
+                        any,
+                    ) {
+                        return best;
                     }
+                    limit = best.map_or(limit, |b| b.t);
                 }
             }
             // Next stacked node still entered no later than the best hit.
@@ -241,5 +256,74 @@ impl RayBvh {
                 }
             }
         }
+    }
+
+    /// The exact tests of the pre-tested lanes `mask` of the packet of triangles
+    /// from leaf-order index `base`, in order of the estimates `est`: the first
+    /// runs at once, each later one only if it still passes the pre-test against
+    /// the best hit so far. Updates `best` (smallest `t`, ties to the smaller
+    /// triangle index, so the order of the tests never changes the answer); true
+    /// when `any` and a hit was found (the caller returns it).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn exact_tests(
+        &self,
+        base: u32,
+        mut mask: u32,
+        est: Vec4,
+        filter: &RayFilter,
+        ray: &Ray,
+        woop: &mut Option<WoopRay>,
+        best: &mut Option<RayHit>,
+        any: bool,
+    ) -> bool {
+        // Lanes by estimate (at most four: insertion; NaN estimates compare
+        // false and stay where they are).
+        let est = est.to_array();
+        let mut cand = [(0u32, 0f32); 4];
+        let mut nc = 0;
+        while mask != 0 {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let item = (base + lane as u32, est[lane]);
+            let mut j = nc;
+            while j > 0 && cand[j - 1].1 > item.1 {
+                cand[j] = cand[j - 1];
+                j -= 1;
+            }
+            cand[j] = item;
+            nc += 1;
+        }
+        let cand = &cand[..nc];
+        for (n, &(k, _)) in cand.iter().enumerate() {
+            let t = &self.tris[k as usize];
+            if n > 0 {
+                if let Some(b) = best {
+                    let e1 = t.v[0] - t.v[1];
+                    let e2 = t.v[2] - t.v[0];
+                    let ng = Vec3A::from_vec4(t.ng);
+                    if !filter.may_hit(t.v[0], e1, e2, ng, t.ng.w, b.t) {
+                        continue;
+                    }
+                }
+            }
+            let w = woop.get_or_insert_with(|| WoopRay::new(ray));
+            let Some(h) = w.hit(&[t.v[0].into(), t.v[1].into(), t.v[2].into()]) else {
+                continue;
+            };
+            let id = self.ids[k as usize];
+            if best.map_or(true, |b| h.t < b.t || (h.t == b.t && id < b.triangle)) {
+                *best = Some(RayHit {
+                    triangle: id,
+                    t: h.t,
+                    u: h.u,
+                    v: h.v,
+                });
+                if any {
+                    return true;
+                }
+            }
+        }
+        false
     }
 }

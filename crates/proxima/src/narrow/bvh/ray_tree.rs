@@ -4,7 +4,7 @@ use super::build::BuildOptions;
 use super::tree::Bvh;
 use crate::geom::Aabb;
 use crate::narrow::bv::BoundingVolume;
-use crate::narrow::ray_triangle::prepare_triangle;
+use crate::narrow::ray_triangle::{prepare_triangle, TriPacket};
 use crate::narrow::TriMesh;
 use crate::{Error, Result};
 use glam::{Vec3, Vec3A, Vec4};
@@ -17,10 +17,10 @@ pub(crate) const LEAF: u32 = 1 << 31;
 /// four with vertical operations only.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct RayNode {
-    /// `lo[axis]`: the children's min corners on `axis`.
-    pub lo: [Vec4; 3],
-    /// `hi[axis]`: the children's max corners on `axis`.
-    pub hi: [Vec4; 3],
+    /// `b[0][axis]`: the children's min corners on `axis`; `b[1][axis]`: their
+    /// max corners (one array, so a cast picks the near side by index, per ray,
+    /// instead of by a select per node).
+    pub b: [[Vec4; 3]; 2],
     /// Child links: a node index, or `LEAF | leaf index`.
     pub child: [u32; 4],
     /// Number of children in use (2 to 4; the first lanes).
@@ -29,8 +29,7 @@ pub(crate) struct RayNode {
 
 impl RayNode {
     const EMPTY: RayNode = RayNode {
-        lo: [Vec4::ZERO; 3],
-        hi: [Vec4::ZERO; 3],
+        b: [[Vec4::ZERO; 3]; 2],
         child: [0; 4],
         len: 0,
     };
@@ -38,15 +37,15 @@ impl RayNode {
     /// The box of lane `k`.
     pub fn lane(&self, k: usize) -> Aabb {
         Aabb {
-            min: Vec3::new(self.lo[0][k], self.lo[1][k], self.lo[2][k]),
-            max: Vec3::new(self.hi[0][k], self.hi[1][k], self.hi[2][k]),
+            min: Vec3::new(self.b[0][0][k], self.b[0][1][k], self.b[0][2][k]),
+            max: Vec3::new(self.b[1][0][k], self.b[1][1][k], self.b[1][2][k]),
         }
     }
 
     fn set_lane(&mut self, k: usize, b: &Aabb) {
         for a in 0..3 {
-            self.lo[a][k] = b.min[a];
-            self.hi[a][k] = b.max[a];
+            self.b[0][a][k] = b.min[a];
+            self.b[1][a][k] = b.max[a];
         }
     }
 
@@ -81,19 +80,25 @@ impl RayTri {
 /// The topology is a [`Bvh`]'s (any bounding volume, any split rule), collapsed
 /// to a 4-wide tree for rays: each node holds the axis-aligned boxes of up to four
 /// children in SIMD lanes (128 bytes), and the triangles are copied in leaf order
-/// with their corners and normal (64 bytes each), so a cast reads no index and no
-/// vertex array. Casts use a precomputed inverse direction, an ordered
+/// with their corners and normal (64 bytes each) and, four at a time, with the
+/// pre-test's data in SIMD lanes (208 bytes per four), so a cast reads no index
+/// and no vertex array. Casts use a precomputed inverse direction, an ordered
 /// front-to-back descent pruned by the best hit, and a conservative `f32`
-/// pre-test before the exact watertight [`ray_triangle`](crate::narrow::ray_triangle):
-/// the answers are exactly those of [`Bvh::cast_ray`] (and of brute force).
+/// pre-test of four triangles at once before the exact watertight
+/// [`ray_triangle`](crate::narrow::ray_triangle) on the survivors, nearest
+/// first: the answers are exactly those of [`Bvh::cast_ray`] (and of brute force).
 ///
-/// Memory: 128 bytes per node (about `2n / (3 leaf_size)` nodes) + 80 bytes per
-/// triangle. After deforming the mesh, call [`RayBvh::refit`].
+/// Memory: 128 bytes per node + about 135 bytes per triangle (at most
+/// `leaf_size` triangles per leaf). After deforming the mesh, call
+/// [`RayBvh::refit`].
 #[derive(Clone, Debug)]
 pub struct RayBvh {
     pub(crate) nodes: Vec<RayNode>,
-    /// `[first triangle, count]` of each leaf (leaf order).
-    pub(crate) leaves: Vec<[u32; 2]>,
+    /// `[first triangle, count, first packet]` of each leaf (leaf order).
+    pub(crate) leaves: Vec<[u32; 3]>,
+    /// The pre-test data of each leaf's triangles, four per packet (the last
+    /// packet of a leaf padded), leaf after leaf.
+    pub(crate) packets: Vec<TriPacket>,
     /// The root's box (the ray first clips against it).
     pub(crate) root: Aabb,
     /// The root's link (a node, or a leaf for a one-leaf tree).
@@ -107,23 +112,41 @@ pub struct RayBvh {
 }
 
 impl RayBvh {
-    /// Builds a [`Bvh<Aabb>`] with `options` (SAH with 4 triangles per leaf is a
-    /// good choice for rays) and re-lays it out for rays. O(n log n).
+    /// Builds a [`Bvh<Aabb>`] down to one triangle per leaf with `options.split`,
+    /// then re-lays it out for rays: a subtree of at most `options.leaf_size`
+    /// triangles becomes one leaf where the surface-area cost model says testing
+    /// its triangles is cheaper than descending (see [`Plan::sah`]), and the
+    /// 4-wide nodes pull up the grandchildren of largest surface area. O(n log n).
     ///
     /// Fails on `leaf_size == 0`.
     pub fn build(mesh: &TriMesh, options: BuildOptions) -> Result<RayBvh> {
-        RayBvh::from_bvh(&Bvh::<Aabb>::build(mesh, options)?, mesh)
+        if options.leaf_size == 0 {
+            return Err(Error::Invalid("BVH leaf size must be at least 1".into()));
+        }
+        let bvh = Bvh::<Aabb>::build(
+            mesh,
+            BuildOptions {
+                leaf_size: 1,
+                ..options
+            },
+        )?;
+        RayBvh::with_plan(&bvh, mesh, &Plan::sah(&bvh, options.leaf_size))
     }
 
     /// The ray layout of `bvh`'s topology over `mesh` (boxes recomputed from the
-    /// vertices, whatever `bvh`'s volume). O(n).
+    /// vertices, whatever `bvh`'s volume): the same leaves. O(n).
     ///
     /// Fails if `mesh` has a different vertex count from the one `bvh` was built on.
     pub fn from_bvh<BV: BoundingVolume>(bvh: &Bvh<BV>, mesh: &TriMesh) -> Result<RayBvh> {
+        RayBvh::with_plan(bvh, mesh, &Plan::same(bvh))
+    }
+
+    fn with_plan<BV: BoundingVolume>(bvh: &Bvh<BV>, mesh: &TriMesh, plan: &Plan) -> Result<RayBvh> {
         bvh.check_vertices(mesh.vertices().len())?;
         let mut t = RayBvh {
             nodes: Vec::with_capacity(bvh.nodes.len() / 2 + 1),
             leaves: Vec::new(),
+            packets: Vec::new(),
             root: Aabb::EMPTY,
             root_link: 0,
             tris: Vec::new(),
@@ -131,31 +154,29 @@ impl RayBvh {
             ids: bvh.ids.clone(),
             n_vertices: mesh.vertices().len(),
         };
-        t.root_link = t.collapse(&bvh.nodes, 0);
+        t.root_link = t.collapse(&bvh.nodes, plan, 0);
         t.fit(mesh.vertices());
         Ok(t)
     }
 
     /// Collapses the binary subtree at `old[i]` into 4-wide nodes (pre-order, so
-    /// children have larger indices than parents); returns its link.
-    fn collapse<BV: BoundingVolume>(&mut self, old: &[super::Node<BV>], i: u32) -> u32 {
-        let n = &old[i as usize];
-        if n.is_leaf() {
-            self.leaves.push([n.start, n.count]);
+    /// children have larger indices than parents), with the leaves of `plan`;
+    /// returns its link.
+    fn collapse<BV>(&mut self, old: &[super::Node<BV>], plan: &Plan, i: u32) -> u32 {
+        if plan.leaf[i as usize] {
+            let [s, n] = plan.range[i as usize];
+            self.leaves.push([s, n, 0]);
             return LEAF | (self.leaves.len() - 1) as u32;
         }
-        // Open internal children, largest volume first, until four lanes.
-        let (l, r) = n.children(i);
+        // Open internal children, largest first, until four lanes.
+        let (l, r) = old[i as usize].children(i);
         let mut lanes = vec![l, r];
         while lanes.len() < 4 {
             let pick = lanes
                 .iter()
                 .enumerate()
-                .filter(|(_, &c)| !old[c as usize].is_leaf())
-                .max_by(|a, b| {
-                    let size = |c: u32| old[c as usize].bv.size();
-                    size(*a.1).total_cmp(&size(*b.1))
-                })
+                .filter(|(_, &c)| !plan.leaf[c as usize])
+                .max_by(|a, b| plan.key[*a.1 as usize].total_cmp(&plan.key[*b.1 as usize]))
                 .map(|(k, _)| k);
             let Some(k) = pick else { break };
             let c = lanes.remove(k);
@@ -168,7 +189,7 @@ impl RayBvh {
         let mut node = RayNode::EMPTY;
         node.len = lanes.len() as u32;
         for (k, &c) in lanes.iter().enumerate() {
-            node.child[k] = self.collapse(old, c);
+            node.child[k] = self.collapse(old, plan, c);
         }
         self.nodes[idx] = node;
         idx as u32
@@ -182,7 +203,16 @@ impl RayBvh {
                 .iter()
                 .map(|c| RayTri::new(c.map(|v| vertices[v as usize]))),
         );
-        let leaf_box = |tris: &[RayTri], [s, n]: [u32; 2]| {
+        self.packets.clear();
+        for leaf in &mut self.leaves {
+            leaf[2] = self.packets.len() as u32;
+            let tris = &self.tris[leaf[0] as usize..(leaf[0] + leaf[1]) as usize];
+            for chunk in tris.chunks(4) {
+                let v: Vec<[Vec3A; 3]> = chunk.iter().map(|t| t.v).collect();
+                self.packets.push(TriPacket::new(&v));
+            }
+        }
+        let leaf_box = |tris: &[RayTri], [s, n, _]: [u32; 3]| {
             let mut b = Aabb::EMPTY;
             for t in &tris[s as usize..(s + n) as usize] {
                 for p in t.v {
@@ -253,9 +283,85 @@ impl RayBvh {
     /// Heap bytes used.
     pub fn memory_bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<RayNode>()
-            + self.leaves.capacity() * 8
+            + self.leaves.capacity() * 12
+            + self.packets.capacity() * std::mem::size_of::<TriPacket>()
             + self.tris.capacity() * std::mem::size_of::<RayTri>()
             + self.corners.capacity() * 12
             + self.ids.capacity() * 4
+    }
+}
+
+/// Relative cost of one packet pre-test (four triangles) in the surface-area
+/// model of [`Plan::sah`] (the unit).
+const COST_PACKET: f32 = 1.0;
+/// Cost of a binary node: a 4-wide node tests about two binary levels at once,
+/// for a bit less than a packet pre-test, so about half of it.
+const COST_NODE: f32 = 0.4;
+/// Fixed cost of visiting a leaf (its range, the candidate pass).
+const COST_LEAF: f32 = 0.25;
+
+/// How a binary tree becomes a ray tree: which binary nodes become leaves (with
+/// their triangle range), and which internal children a 4-wide node opens first.
+struct Plan {
+    leaf: Vec<bool>,
+    /// `[first triangle, count]` of each node's subtree (leaf order).
+    range: Vec<[u32; 2]>,
+    /// Opening priority of internal nodes (larger first).
+    key: Vec<f32>,
+}
+
+impl Plan {
+    /// `bvh`'s own leaves, children opened by [`BoundingVolume::size`].
+    fn same<BV: BoundingVolume>(bvh: &Bvh<BV>) -> Plan {
+        let n = &bvh.nodes;
+        Plan {
+            leaf: n.iter().map(|n| n.is_leaf()).collect(),
+            range: n.iter().map(|n| [n.start, n.count]).collect(),
+            key: n.iter().map(|n| n.bv.size()).collect(),
+        }
+    }
+
+    /// The leaves the surface-area heuristic chooses (Goldsmith & Salmon, MacDonald
+    /// & Booth): bottom-up, a subtree of at most `max_leaf` triangles becomes a leaf
+    /// when `area · (COST_LEAF + COST_PACKET · ⌈count / 4⌉)` is no more than the cost
+    /// of keeping it, `area · COST_NODE` plus its children's costs (the chance of a
+    /// random ray hitting a box is proportional to its area). Children are opened by
+    /// surface area. O(nodes).
+    fn sah(bvh: &Bvh<Aabb>, max_leaf: usize) -> Plan {
+        let n = &bvh.nodes;
+        let area = |b: &Aabb| {
+            let e = b.extent();
+            e.x * e.y + e.y * e.z + e.z * e.x
+        };
+        let mut p = Plan {
+            leaf: vec![false; n.len()],
+            range: vec![[0, 0]; n.len()],
+            key: n.iter().map(|n| area(&n.bv)).collect(),
+        };
+        let mut cost = vec![0.0f32; n.len()];
+        // Children have larger indices: a reverse sweep is bottom-up.
+        for i in (0..n.len()).rev() {
+            let a = p.key[i];
+            if n[i].is_leaf() {
+                p.leaf[i] = true;
+                p.range[i] = [n[i].start, n[i].count];
+                cost[i] = a * (COST_LEAF + COST_PACKET * n[i].count.div_ceil(4) as f32);
+                continue;
+            }
+            let (l, r) = n[i].children(i as u32);
+            let (l, r) = (l as usize, r as usize);
+            // Pre-order: the left subtree's triangles come first.
+            let count = p.range[l][1] + p.range[r][1];
+            p.range[i] = [p.range[l][0], count];
+            let keep = a * COST_NODE + cost[l] + cost[r];
+            let merged = a * (COST_LEAF + COST_PACKET * count.div_ceil(4) as f32);
+            if count as usize <= max_leaf && merged <= keep {
+                p.leaf[i] = true;
+                cost[i] = merged;
+            } else {
+                cost[i] = keep;
+            }
+        }
+        p
     }
 }

@@ -113,7 +113,7 @@ impl Geometry {
     }
 
     /// Coordinates of cell index `i`.
-    #[inline]
+    #[cfg(test)]
     pub fn coords(&self, i: u32) -> [u32; 3] {
         let [nx, ny, _] = self.dims;
         [i % nx, (i / nx) % ny, i / (nx * ny)]

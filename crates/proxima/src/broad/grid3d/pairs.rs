@@ -133,9 +133,23 @@ struct Ring {
 
 impl Ring {
     fn new<T>(g: &UniformGrid3d<T>, w0: u32) -> Ring {
-        let ny = g.geom.dims[1] as usize;
+        let [nx, ny, _] = g.geom.dims.map(|d| d as usize);
+        // Room for twice an average row up front: growing ny + 2 rows of seven
+        // vectors a step at a time costs thousands of reallocations per search
+        // in a wide flat world (W2).
+        let gridded = g.items.len() - g.large.len();
+        let per_row = 2 * gridded / g.row_count() as usize + INLINE + PAD;
+        let row = || Row {
+            off: Vec::with_capacity(nx + 1),
+            x: Vec::with_capacity(per_row),
+            y: Vec::with_capacity(per_row),
+            z: Vec::with_capacity(per_row),
+            r: Vec::with_capacity(per_row),
+            slot: Vec::with_capacity(per_row),
+            cx: Vec::with_capacity(per_row),
+        };
         Ring {
-            rows: (0..ny + 2).map(|_| Row::default()).collect(),
+            rows: (0..ny + 2).map(|_| row()).collect(),
             next: w0,
         }
     }
@@ -151,17 +165,18 @@ impl Ring {
             // whole, whatever its count (the surplus is overwritten by the next
             // cell), so that the loop does not branch on the counts...
             let c0 = (w * nx) as usize;
-            let counts = &g.store.counts[c0..c0 + nx as usize];
-            let total: usize = counts.iter().map(|&n| n as usize).sum();
+            let cells = &g.store.cells[c0..c0 + nx as usize];
+            let total: usize = cells.iter().map(|c| c.count as usize).sum();
             row.off.clear();
             row.slot.clear();
             row.slot.resize(total + INLINE, 0);
             row.cx.clear();
             row.cx.resize(total + INLINE, 0);
             let mut p = 0;
-            for (x, (&n, inline)) in counts.iter().zip(&g.store.slots[c0..]).enumerate() {
+            for (x, cell) in cells.iter().enumerate() {
+                let n = cell.count;
                 row.off.push(p as u32);
-                row.slot[p..p + INLINE].copy_from_slice(inline);
+                row.slot[p..p + INLINE].copy_from_slice(&cell.slots);
                 row.cx[p..p + INLINE].fill(x as u32);
                 if n as usize > INLINE {
                     // A spilled cell (rare in even scenes): the rest of it.

@@ -21,11 +21,12 @@ pub const GRID_FRACTION: f32 = 0.49;
 /// of a cell near the grid).
 pub const MAX_CELLS_PER_AXIS: u32 = 1 << 12;
 
-/// Most cells in a grid (about 20 bytes each).
+/// Most cells in a grid (16 bytes each).
 pub const MAX_CELLS: u64 = 1 << 21;
 
-/// Spheres stored inline in a cell; more spill to a side table.
-pub const INLINE: usize = 4;
+/// Slots stored inline in a cell (with the count, 16 bytes: a quarter of a
+/// cache line); more spill to a side table.
+pub const INLINE: usize = 3;
 
 /// Marks "no cell" (a large object's location).
 pub const NO_CELL: u32 = u32::MAX;
@@ -113,7 +114,7 @@ impl Geometry {
     }
 
     /// Coordinates of cell index `i`.
-    #[inline]
+    #[cfg(test)]
     pub fn coords(&self, i: u32) -> [u32; 3] {
         let [nx, ny, _] = self.dims;
         [i % nx, (i / nx) % ny, i / (nx * ny)]
@@ -180,16 +181,23 @@ impl Geometry {
     }
 }
 
-/// Every cell's objects by slot: a dense count per cell (so an empty neighbour
-/// costs one 4-byte read), up to [`INLINE`] slots stored in the cell itself, and
-/// any further ones in a side table. Positions `0..count` name a cell's entries;
-/// removal swaps the last entry into the hole. The spheres themselves live in one
-/// array by slot, so an update that keeps its cell writes where the caller's
-/// updates already stream (see the pair search for how they are read back).
+/// One cell: its number of entries and the first [`INLINE`] of their slots.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Cell {
+    pub count: u32,
+    pub slots: [u32; INLINE],
+}
+
+/// Every cell's objects by slot: one 16-byte record per cell (the count and up
+/// to [`INLINE`] slots, so that moving an object between cells touches one
+/// cache line per cell, and an empty neighbour costs one read), any further
+/// slots in a side table. Positions `0..count` name a cell's entries; removal
+/// swaps the last entry into the hole. The spheres themselves live in one array
+/// by slot, so an update that keeps its cell writes where the caller's updates
+/// already stream (see the pair search for how they are read back).
 #[derive(Clone, Debug)]
 pub struct CellStore {
-    pub counts: Vec<u32>,
-    pub slots: Vec<[u32; INLINE]>,
+    pub cells: Vec<Cell>,
     pub spill: FxHashMap<u32, Vec<u32>>,
 }
 
@@ -197,17 +205,23 @@ impl CellStore {
     /// `n` empty cells.
     pub fn new(n: usize) -> CellStore {
         CellStore {
-            counts: vec![0; n],
-            slots: vec![[0; INLINE]; n],
+            cells: vec![Cell::default(); n],
             spill: FxHashMap::default(),
         }
+    }
+
+    /// Number of entries of cell `c`.
+    #[inline]
+    pub fn count(&self, c: u32) -> u32 {
+        self.cells[c as usize].count
     }
 
     /// The slots of cell `c`: the inline part and the spilled part.
     #[inline]
     pub fn parts(&self, c: u32) -> [&[u32]; 2] {
-        let n = self.counts[c as usize] as usize;
-        let inline = &self.slots[c as usize][..n.min(INLINE)];
+        let cell = &self.cells[c as usize];
+        let n = cell.count as usize;
+        let inline = &cell.slots[..n.min(INLINE)];
         if n > INLINE {
             [inline, &self.spill[&c][..]]
         } else {
@@ -220,7 +234,7 @@ impl CellStore {
     pub fn slot(&self, c: u32, i: u32) -> u32 {
         let i = i as usize;
         if i < INLINE {
-            self.slots[c as usize][i]
+            self.cells[c as usize].slots[i]
         } else {
             self.spill[&c][i - INLINE]
         }
@@ -231,7 +245,7 @@ impl CellStore {
     fn set_slot(&mut self, c: u32, i: u32, slot: u32) {
         let i = i as usize;
         if i < INLINE {
-            self.slots[c as usize][i] = slot;
+            self.cells[c as usize].slots[i] = slot;
         } else if let Some(sp) = self.spill.get_mut(&c) {
             sp[i - INLINE] = slot;
         }
@@ -240,13 +254,14 @@ impl CellStore {
     /// Appends `slot` to cell `c` and returns its position. O(1) amortized.
     #[inline]
     pub fn push(&mut self, c: u32, slot: u32) -> u32 {
-        let n = self.counts[c as usize];
+        let cell = &mut self.cells[c as usize];
+        let n = cell.count;
+        cell.count = n + 1;
         if (n as usize) < INLINE {
-            self.slots[c as usize][n as usize] = slot;
+            cell.slots[n as usize] = slot;
         } else {
             self.spill.entry(c).or_default().push(slot);
         }
-        self.counts[c as usize] = n + 1;
         n
     }
 
@@ -254,7 +269,7 @@ impl CellStore {
     /// into its place; returns the slot that moved to `i`, if any. O(1).
     #[inline]
     pub fn remove(&mut self, c: u32, i: u32) -> Option<u32> {
-        let last = self.counts[c as usize] - 1;
+        let last = self.cells[c as usize].count - 1;
         let moved = (i != last).then(|| {
             let slot = self.slot(c, last);
             self.set_slot(c, i, slot);
@@ -267,13 +282,13 @@ impl CellStore {
                 self.spill.remove(&c);
             }
         }
-        self.counts[c as usize] = last;
+        self.cells[c as usize].count = last;
         moved
     }
 
     /// Heap bytes.
     pub fn heap_bytes(&self) -> usize {
-        self.counts.capacity() * (4 + std::mem::size_of::<[u32; INLINE]>())
+        self.cells.capacity() * std::mem::size_of::<Cell>()
             + self.spill.capacity() * (std::mem::size_of::<(u32, Vec<u32>)>() + 1)
             + self.spill.values().map(|s| s.capacity() * 4).sum::<usize>()
     }
@@ -303,17 +318,17 @@ mod tests {
     #[test]
     fn store_spills_and_swaps() {
         let mut st = CellStore::new(2);
-        for k in 0..7 {
+        for k in 0..6 {
             assert_eq!(st.push(1, k), k);
         }
-        assert_eq!(st.parts(1)[1], &[4, 5, 6]);
+        assert_eq!(st.parts(1)[1], &[3, 4, 5]);
         // Removing an inline entry pulls the last spilled one in.
-        assert_eq!(st.remove(1, 0), Some(6));
-        assert_eq!(st.slot(1, 0), 6);
-        assert_eq!(st.remove(1, 5), None);
+        assert_eq!(st.remove(1, 0), Some(5));
+        assert_eq!(st.slot(1, 0), 5);
         assert_eq!(st.remove(1, 4), None);
+        assert_eq!(st.remove(1, 3), None);
         assert!(st.spill.is_empty());
-        assert_eq!(st.parts(1)[0], &[6, 1, 2, 3]);
-        assert_eq!(st.counts, vec![0, 4]);
+        assert_eq!(st.parts(1)[0], &[5, 1, 2]);
+        assert_eq!((st.count(0), st.count(1)), (0, 3));
     }
 }

@@ -1,4 +1,4 @@
-//! [`ParallelPairs`] for the dense grid: runs of cells split across rayon's
+//! [`ParallelPairs`] for the dense grid: runs of rows of cells split across rayon's
 //! threads (a few runs per thread, each at least a few xy layers so that the
 //! scan's look-ahead stays small beside the run), then the large objects one
 //! task each.
@@ -11,12 +11,12 @@ use std::ops::ControlFlow;
 /// Tasks per thread: enough to balance uneven cells across threads.
 const TASKS_PER_THREAD: u32 = 4;
 
-/// Each task also gathers the spheres of one xy layer of cells beyond its run
+/// Each task also gathers the spheres of one xy layer of rows beyond its run
 /// (the look-ahead of the pair scan), so a run is at least this many layers.
 const MIN_LAYERS_PER_TASK: u32 = 4;
 
 impl<T: Send + Sync> ParallelPairs<T> for UniformGrid3d<T> {
-    /// Each task runs the sequential half-shell search over its own run of cells
+    /// Each task runs the sequential half-shell search over its own run of rows
     /// (every pair is owned by the cell of its first object, so runs never report
     /// the same pair), folding into its accumulator; the large objects' pairs are
     /// folded the same way, one object per task.
@@ -27,21 +27,21 @@ impl<T: Send + Sync> ParallelPairs<T> for UniformGrid3d<T> {
         F: Fn(A, crate::broad::Handle, &T, crate::broad::Handle, &T) -> A + Sync + Send,
         R: Fn(A, A) -> A + Sync + Send,
     {
-        let cells = self.geom.cell_count() as u32;
-        let [nx, ny, _] = self.geom.dims;
+        let rows = self.row_count();
+        let ny = self.geom.dims[1];
         let threads = rayon::current_num_threads() as u32;
-        let per_task = cells
+        let per_task = rows
             .div_ceil(TASKS_PER_THREAD * threads)
-            .max(MIN_LAYERS_PER_TASK * nx * ny)
+            .max(MIN_LAYERS_PER_TASK * ny)
             .max(1);
-        let tasks = cells.div_ceil(per_task);
+        let tasks = rows.div_ceil(per_task);
         let gridded = (0..tasks)
             .into_par_iter()
             .fold(&init, |acc, t| {
-                let c0 = t * per_task;
-                let c1 = (c0 + per_task).min(cells);
+                let w0 = t * per_task;
+                let w1 = (w0 + per_task).min(rows);
                 let mut acc = Some(acc);
-                let _ = self.visit_pairs(c0, c1, &mut |ha, va, hb, vb| {
+                let _ = self.visit_pairs(w0, w1, &mut |ha, va, hb, vb| {
                     acc = acc.take().map(|a| fold(a, ha, va, hb, vb));
                     ControlFlow::Continue(())
                 });

@@ -36,7 +36,7 @@ impl<T> UniformGrid3d<T> {
     ) -> ControlFlow<()> {
         let first = self.geom.index(start);
         for (x, c) in (start[0]..=x1).zip(first..) {
-            let n = self.store.counts[c as usize];
+            let n = self.store.count(c);
             if n == 0 {
                 continue;
             }

@@ -18,7 +18,7 @@ impl<T> UniformGrid3d<T> {
     pub(super) fn check(&self) -> Result<()> {
         self.items.validate()?;
         let n = self.geom.cell_count();
-        if self.store.counts.len() != n || self.store.slots.len() != n {
+        if self.store.cells.len() != n {
             return fail(format!("cell arrays do not have {n} cells"));
         }
         for (h, _) in self.items.iter() {
@@ -39,7 +39,7 @@ impl<T> UniformGrid3d<T> {
                 }
                 continue;
             }
-            if cell as usize >= n || idx >= self.store.counts[cell as usize] {
+            if cell as usize >= n || idx >= self.store.count(cell) {
                 return fail(format!("slot {slot} has an invalid location {loc:?}"));
             }
             if self.store.slot(cell, idx) != slot {
@@ -56,7 +56,7 @@ impl<T> UniformGrid3d<T> {
                 return fail(format!("bounds do not cover slot {slot}"));
             }
         }
-        let gridded: usize = self.store.counts.iter().map(|&c| c as usize).sum();
+        let gridded: usize = self.store.cells.iter().map(|c| c.count as usize).sum();
         if gridded + self.large.len() != self.items.len() {
             return fail(format!(
                 "{gridded} gridded + {} large objects, {} stored",
@@ -65,16 +65,16 @@ impl<T> UniformGrid3d<T> {
             ));
         }
         for (&c, sp) in &self.store.spill {
-            let count = self.store.counts.get(c as usize).copied().unwrap_or(0) as usize;
+            let count = self.store.cells.get(c as usize).map_or(0, |c| c.count) as usize;
             if sp.is_empty() || count != INLINE + sp.len() {
                 return fail(format!("spill of cell {c} does not match its count"));
             }
         }
         let spilled = self
             .store
-            .counts
+            .cells
             .iter()
-            .filter(|&&c| c as usize > INLINE)
+            .filter(|c| c.count as usize > INLINE)
             .count();
         if spilled != self.store.spill.len() {
             return fail(format!("{spilled} cells need a spill table entry"));

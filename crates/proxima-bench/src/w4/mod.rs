@@ -4,7 +4,8 @@
 //! centres uniform in a cube of side `4·N^(1/3)`) are loaded once into every
 //! structure (build timed; Proxima's indices are loaded by inserting in Morton
 //! order of the centres, `--order input` for the generated order), then each
-//! query kind runs as a batch ([`queries`]), `R` times; the table gives the median batch time per query, the hits per batch
+//! query kind runs as a batch ([`queries`]), `R` rounds in which the structures take
+//! turns, one batch each (so load from elsewhere hits them alike); the table gives the median batch time per query, the hits per batch
 //! (checked equal across all structures — exit 1 otherwise), bytes per object and
 //! the time relative to the best peer for that kind.
 //!
@@ -254,55 +255,66 @@ pub fn run(a: &Args) -> (Vec<(QueryKind, Vec<Row>)>, Vec<String>) {
         QueryKind::ALL.iter().map(|&k| (k, Vec::new())).collect();
     let mut reference: Vec<Option<(u64, u64, &'static str)>> = vec![None; QueryKind::ALL.len()];
     let mut errors = Vec::new();
+    // Build every structure first, then time them round-robin (per round and
+    // kind, one batch each): load from elsewhere on the machine then hits every
+    // structure alike, so the ratios of one run are steadier.
+    let mut built = Vec::new();
     for e in entries() {
         let wanted = a.only.is_empty() || a.only.iter().any(|o| o.eq_ignore_ascii_case(e.name));
         if !wanted || (e.quadratic && a.n > QUADRATIC_LIMIT) {
             continue;
         }
-        eprintln!("running {} ...", e.name);
+        eprintln!("building {} ...", e.name);
         let (engine, build) = a.clock.time(|| (e.build)(&w.spheres, &scene, a.morton));
-        let bytes = engine.memory_bytes() as f64 / a.n as f64;
-        for (k, (kind, out)) in rows.iter_mut().enumerate() {
-            let mut row = Row {
+        built.push((e, engine, build));
+    }
+    // times[kind][structure]
+    let mut times = vec![vec![Vec::with_capacity(a.reps); built.len()]; rows.len()];
+    let mut hits = vec![vec![0u64; built.len()]; rows.len()];
+    for round in 0..a.reps {
+        eprintln!("round {} of {} ...", round + 1, a.reps);
+        for (k, (kind, _)) in rows.iter().enumerate() {
+            for (i, (e, engine, _)) in built.iter().enumerate() {
+                if !engine.supports(*kind) {
+                    continue;
+                }
+                // One thread: on this thread, so its CPU clock sees the work
+                // (`install` would hand it to a pool worker).
+                let (counts, t) = a.clock.time(|| match &pool {
+                    Some(p) => p.install(|| engine.counts(&batches, *kind, true)),
+                    None => engine.counts(&batches, *kind, false),
+                });
+                times[k][i].push(t);
+                let (total, check) = digest(&counts.expect("supported kind"));
+                hits[k][i] = total;
+                match reference[k] {
+                    None => reference[k] = Some((total, check, e.name)),
+                    Some((t0, c0, who)) if (t0, c0) != (total, check) => errors.push(format!(
+                        "HIT MISMATCH on {} queries: {who} found {t0} hits, {} found {total}{}",
+                        kind.name(),
+                        e.name,
+                        if t0 == total {
+                            " (same total, different per-query counts)"
+                        } else {
+                            ""
+                        }
+                    )),
+                    _ => {}
+                }
+            }
+        }
+    }
+    for (k, (kind, out)) in rows.iter_mut().enumerate() {
+        for (i, (e, engine, build)) in built.iter().enumerate() {
+            out.push(Row {
                 name: e.name,
                 peer: e.peer,
-                build,
-                batch: None,
-                hits: 0,
-                bytes_per_object: bytes,
-            };
-            if engine.supports(*kind) {
-                let mut times = Vec::with_capacity(a.reps);
-                for _ in 0..a.reps {
-                    // One thread: on this thread, so its CPU clock sees the work
-                    // (`install` would hand it to a pool worker).
-                    let (counts, t) = a.clock.time(|| match &pool {
-                        Some(p) => p.install(|| engine.counts(&batches, *kind, true)),
-                        None => engine.counts(&batches, *kind, false),
-                    });
-                    times.push(t);
-                    let (total, check) = digest(&counts.expect("supported kind"));
-                    row.hits = total;
-                    match reference[k] {
-                        None => reference[k] = Some((total, check, e.name)),
-                        Some((t0, c0, who)) if (t0, c0) != (total, check) => errors.push(format!(
-                            "HIT MISMATCH on {} queries: {who} found {t0} hits, {} found {total}{}",
-                            kind.name(),
-                            e.name,
-                            if t0 == total {
-                                " (same total, different per-query counts)"
-                            } else {
-                                ""
-                            }
-                        )),
-                        _ => {}
-                    }
-                }
-                row.batch = Some(median(&times));
-            }
-            out.push(row);
+                build: *build,
+                batch: engine.supports(*kind).then(|| median(&times[k][i])),
+                hits: hits[k][i],
+                bytes_per_object: engine.memory_bytes() as f64 / a.n as f64,
+            });
         }
-        drop(engine);
     }
     errors.dedup();
     (rows, errors)

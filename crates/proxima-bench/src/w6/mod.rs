@@ -4,7 +4,8 @@
 //!
 //! For each mesh of `shared/data` (or `--mesh`), R rays ([`rays::rays`]) go through
 //! every structure ([`structures::entries`]): build time, median time per ray over
-//! the repeats on one thread (thread CPU time by default), the same batch on a
+//! the repeats on one thread (thread CPU time by default; the structures take
+//! turns, one batch each per round, so load from elsewhere hits them alike), the same batch on a
 //! rayon pool of each `--threads` size (wall time: several threads), hits, and the
 //! ratio to obvhs. In the same run every answer is checked ([`check`]): Proxima's
 //! structures must agree exactly with each other and with brute force (on a subset,
@@ -128,6 +129,11 @@ fn run_mesh(a: &Args, mesh: &TriMesh, out: &mut Vec<Row>) -> Result<(), String> 
         leaf_size: a.leaf,
     };
     let mut verifier = Verifier::new(mesh, &rays);
+    // Build everything first, then time the structures round-robin, one batch
+    // each per round: a burst of load from elsewhere on the machine then lands on
+    // every structure alike instead of on whichever was running, so the ratios
+    // of one run are steadier than with each structure's repeats back to back.
+    let mut built = Vec::new();
     for e in structures::entries() {
         if !a.only.is_empty() && !a.only.iter().any(|o| o == e.name) {
             continue;
@@ -135,16 +141,22 @@ fn run_mesh(a: &Args, mesh: &TriMesh, out: &mut Vec<Row>) -> Result<(), String> 
         eprintln!("  {} ...", e.name);
         let (s, build) = a.clock.time(|| (e.make)(mesh, opts));
         let set: &[Ray] = if e.subset { &rays[..brute_n] } else { &rays };
-        let repeats = if e.subset { 1 } else { a.repeats };
-        let mut times = Vec::with_capacity(repeats);
-        let mut res = Vec::new();
-        for _ in 0..repeats {
+        built.push((e, s, build, set, Vec::with_capacity(a.repeats), Vec::new()));
+    }
+    for round in 0..a.repeats {
+        for (e, s, _, set, times, res) in built.iter_mut() {
+            // The subset (brute force) runs once: it is the check, not a peer.
+            if e.subset && round > 0 {
+                continue;
+            }
             let (r, t) = a
                 .clock
                 .time(|| set.iter().map(|r| s.cast(r)).collect::<Vec<_>>());
             times.push(t);
-            res = r;
+            *res = r;
         }
+    }
+    for (e, s, build, set, times, res) in built {
         let mut par = Vec::new();
         if !e.subset {
             for &k in &a.threads {
@@ -152,8 +164,8 @@ fn run_mesh(a: &Args, mesh: &TriMesh, out: &mut Vec<Row>) -> Result<(), String> 
                     .num_threads(k)
                     .build()
                     .map_err(|e| e.to_string())?;
-                let mut pt = Vec::with_capacity(repeats);
-                for _ in 0..repeats {
+                let mut pt = Vec::with_capacity(a.repeats);
+                for _ in 0..a.repeats {
                     let (r, t) = Clock::Wall.time(|| pool.install(|| s.cast_par(set)));
                     if r != res {
                         return Err(format!(

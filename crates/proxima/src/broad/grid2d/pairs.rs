@@ -11,9 +11,12 @@ impl<T> UniformGrid2d<T> {
     /// Two overlapping objects have overlapping footprints, so they share at least
     /// one cell. A pair found in cell `(x, y)` is reported only if that cell is
     /// the lowest one both cover, `(max(ax0, bx0), max(ay0, by0))` — read from the
-    /// lowest cells stored in the references, so the check costs two comparisons
-    /// and runs only after the sphere test succeeded. Cost O(Σ k²) sphere tests
-    /// over cells with `k` references.
+    /// lowest cells stored in the references. That check costs two comparisons
+    /// and runs before the sphere test, so each pair is sphere-tested once, in its
+    /// lowest common cell, however many cells the two share (large objects listed
+    /// in thousands of cells, with ties that need the exact test, made the search
+    /// take seconds otherwise). Cost O(Σ k²) comparisons over cells with `k`
+    /// references, and one sphere test per pair of objects sharing a cell.
     pub(super) fn visit_pairs(
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
@@ -28,9 +31,9 @@ impl<T> UniformGrid2d<T> {
             for (i, ea) in es.iter().enumerate() {
                 let sa = &self.spheres[ea.slot as usize];
                 for eb in &es[i + 1..] {
-                    if overlap::sphere_sphere(sa, &self.spheres[eb.slot as usize])
-                        && ea.lo[0].max(eb.lo[0]) == x
+                    if ea.lo[0].max(eb.lo[0]) == x
                         && ea.lo[1].max(eb.lo[1]) == y
+                        && overlap::sphere_sphere(sa, &self.spheres[eb.slot as usize])
                     {
                         let (ha, va) = self.resolve(ea.slot);
                         let (hb, vb) = self.resolve(eb.slot);

@@ -11,7 +11,8 @@ impl<T> HashGrid<T> {
     ///
     /// Gridded pairs: two overlapping objects share a cell; the pair is reported
     /// only from the lowest cell both cover (`max` of their lowest cells per axis),
-    /// checked after the sphere test. Pairs with an oversized object: each
+    /// checked before the sphere test so that each pair is sphere-tested once,
+    /// however many cells it shares. Pairs with an oversized object: each
     /// oversized object against the others after it in the list, then a grid query
     /// with its sphere (each gridded object once, by the query's own rule). Cost
     /// O(Σ k² + oversized² + oversized × query).
@@ -28,10 +29,10 @@ impl<T> HashGrid<T> {
             for (i, ea) in es.iter().enumerate() {
                 let sa = &self.spheres[ea.slot as usize];
                 for eb in &es[i + 1..] {
-                    if overlap::sphere_sphere(sa, &self.spheres[eb.slot as usize])
-                        && ea.lo[0].max(eb.lo[0]) == key[0]
+                    if ea.lo[0].max(eb.lo[0]) == key[0]
                         && ea.lo[1].max(eb.lo[1]) == key[1]
                         && ea.lo[2].max(eb.lo[2]) == key[2]
+                        && overlap::sphere_sphere(sa, &self.spheres[eb.slot as usize])
                     {
                         let (ha, va) = self.resolve(ea.slot);
                         let (hb, vb) = self.resolve(eb.slot);

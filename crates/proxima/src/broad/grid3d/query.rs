@@ -155,7 +155,8 @@ impl<T> UniformGrid3d<T> {
     /// Reports the objects of cell `c` selected by `q`: all of them if `rel`
     /// is `Inside`, else those passing the exact test over the planes in
     /// `mask` (the others keep every sphere of the cell).
-    #[inline]
+    // Always inlined: the loop body of the small-range row scan.
+    #[inline(always)]
     fn test_cell<Q: Selection + ?Sized>(
         &self,
         q: &Q,

@@ -123,6 +123,25 @@ pub fn sphere_aabb(s: &Sphere, b: &Aabb) -> bool {
     within(s.center, q, s.radius, 0.0)
 }
 
+/// Sphere contains AABB: every point of `b` is within `s` (boundary included),
+/// decided exactly. A ball is convex, so it contains the box iff it contains the
+/// box's 8 corners, each tested like [`sphere_sphere`] with a point. A box with
+/// an infinite or NaN coordinate is never contained. O(1) (8 point tests).
+#[inline]
+pub fn sphere_contains_aabb(s: &Sphere, b: &Aabb) -> bool {
+    if !b.min.is_finite() || !b.max.is_finite() {
+        return false;
+    }
+    (0..8u8).all(|i| {
+        let p = Vec3::select(
+            glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0),
+            b.max,
+            b.min,
+        );
+        within(p, s.center, 0.0, s.radius)
+    })
+}
+
 /// AABB–AABB: the intervals overlap on all three axes.
 #[inline]
 pub fn aabb_aabb(a: &Aabb, b: &Aabb) -> bool {
@@ -493,10 +512,22 @@ fn plane_sphere_exact(terms: [f64; 4], n: [f64; 3], r: f64, n2: f64, sign: Order
 /// sphere at any magnitude. A NaN (only from a NaN plane) never culls.
 #[inline]
 pub fn frustum_sphere(f: &Frustum, s: &Sphere) -> Relation {
+    frustum_sphere_masked(f, s, Frustum::ALL_PLANES)
+}
+
+/// [`frustum_sphere`] over the planes whose bit is set in `mask` only (bit `i`
+/// = plane `i`): the planes a hierarchy's plane masking has shown to contain
+/// the sphere need no test. Exact like [`frustum_sphere`]; with a full mask it
+/// is [`frustum_sphere`]. O(planes in `mask`).
+#[inline]
+pub fn frustum_sphere_masked(f: &Frustum, s: &Sphere, mask: u8) -> Relation {
     let mut rel = Relation::Inside;
     let c = d3(s.center);
     let r = s.radius as f64;
-    for p in &f.planes {
+    for (i, p) in f.planes.iter().enumerate() {
+        if mask & (1 << i) == 0 {
+            continue;
+        }
         let (n, dd) = (d3(p.normal), p.d as f64);
         // The radius in the plane's units is `r |n|`: `r` for the unit normals of
         // `from_view_projection`; 0 for a zero normal (a degenerate matrix: the
@@ -527,7 +558,21 @@ pub fn frustum_sphere(f: &Frustum, s: &Sphere) -> Relation {
 /// proves a plane contains the box.
 #[inline]
 pub fn frustum_aabb(f: &Frustum, b: &Aabb, mask: u8) -> (Relation, u8) {
-    let (lo, hi) = (d3(b.min), d3(b.max));
+    frustum_aabb_centres(f, b, b, mask)
+}
+
+/// Frustum test of a block of spheres known by two boxes: every sphere has its
+/// centre in `centres` and lies inside `loose`. Per plane in `mask`: `loose`
+/// wholly outside the plane culls the block (`Outside`); `centres` wholly
+/// inside it drops the plane from the returned mask (a sphere whose centre is
+/// inside a plane is not culled by it, see [`frustum_sphere`]). `Inside` when
+/// the returned mask is empty: every sphere of the block is kept by
+/// [`frustum_sphere`]. With `centres == loose` this is [`frustum_aabb`]. Exact,
+/// by the same corner sums as [`frustum_aabb`]. O(planes in `mask`).
+#[inline]
+pub fn frustum_aabb_centres(f: &Frustum, centres: &Aabb, loose: &Aabb, mask: u8) -> (Relation, u8) {
+    let (lo, hi) = (d3(loose.min), d3(loose.max));
+    let (clo, chi) = (d3(centres.min), d3(centres.max));
     let mut out_mask = 0u8;
     for (i, p) in f.planes.iter().enumerate() {
         let bit = 1u8 << i;
@@ -536,17 +581,9 @@ pub fn frustum_aabb(f: &Frustum, b: &Aabb, mask: u8) -> (Relation, u8) {
         }
         let n = d3(p.normal);
         // A zero normal component contributes 0 whatever the box (no 0 · ∞).
-        let term = |k: usize, pick_hi: bool| {
-            if n[k] == 0.0 {
-                0.0
-            } else if pick_hi {
-                n[k] * hi[k]
-            } else {
-                n[k] * lo[k]
-            }
-        };
-        let far = [0, 1, 2].map(|k| term(k, n[k] > 0.0));
-        let near = [0, 1, 2].map(|k| term(k, n[k] < 0.0));
+        let term = |k: usize, v: f64| if n[k] == 0.0 { 0.0 } else { n[k] * v };
+        let far = [0, 1, 2].map(|k| term(k, if n[k] > 0.0 { hi[k] } else { lo[k] }));
+        let near = [0, 1, 2].map(|k| term(k, if n[k] < 0.0 { chi[k] } else { clo[k] }));
         let dd = p.d as f64;
         if sum4_sign([far[0], far[1], far[2], dd]) == Some(Ordering::Less) {
             return (Relation::Outside, 0);

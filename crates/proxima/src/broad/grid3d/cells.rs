@@ -120,11 +120,19 @@ impl Geometry {
         [i % nx, (i / nx) % ny, i / (nx * ny)]
     }
 
-    /// Padding added to query boxes: the largest gridded radius plus a margin
-    /// for rounding (2 % of a cell and a relative term for far coordinates).
+    /// Padding added to query boxes: the largest gridded radius plus the
+    /// rounding [`Geometry::margin`].
     #[inline]
     pub fn reach(&self, v: f32) -> f32 {
-        self.limit + 0.02 * self.cell + v.abs() * 1e-5
+        self.limit + self.margin(v)
+    }
+
+    /// Margin for the rounding of cell coordinates near `v` (2 % of a cell and a
+    /// relative term for far coordinates): a centre mapped to a cell lies within
+    /// this of the cell's slab.
+    #[inline]
+    pub fn margin(&self, v: f32) -> f32 {
+        0.02 * self.cell + v.abs() * 1e-5
     }
 
     /// Cells `[lo, hi]` (inclusive, clamped) that can hold the centre of a
@@ -170,12 +178,35 @@ impl Geometry {
     /// A box containing every gridded sphere whose centre is in cell `c`.
     #[inline]
     pub fn loose(&self, c: [u32; 3]) -> Aabb {
+        self.loose_block(c, c)
+    }
+
+    /// A box containing the centre of every gridded sphere in one of the cells
+    /// `[lo, hi]` (inclusive): the block's slabs widened by the margin.
+    #[inline]
+    pub fn centre_block(&self, lo: [u32; 3], hi: [u32; 3]) -> Aabb {
         let mut min = glam::Vec3::ZERO;
         let mut max = glam::Vec3::ZERO;
         for a in 0..3 {
-            let (lo, hi) = self.slab(c[a], a);
-            min[a] = lo - self.reach(lo);
-            max[a] = hi + self.reach(hi);
+            let l = self.slab(lo[a], a).0;
+            let h = self.slab(hi[a], a).1;
+            min[a] = l - self.margin(l);
+            max[a] = h + self.margin(h);
+        }
+        Aabb::new(min, max)
+    }
+
+    /// A box containing every gridded sphere whose centre is in one of the
+    /// cells `[lo, hi]` (inclusive): the block's slabs widened by the reach.
+    #[inline]
+    pub fn loose_block(&self, lo: [u32; 3], hi: [u32; 3]) -> Aabb {
+        let mut min = glam::Vec3::ZERO;
+        let mut max = glam::Vec3::ZERO;
+        for a in 0..3 {
+            let l = self.slab(lo[a], a).0;
+            let h = self.slab(hi[a], a).1;
+            min[a] = l - self.reach(l);
+            max[a] = h + self.reach(h);
         }
         Aabb::new(min, max)
     }

@@ -62,7 +62,11 @@ struct Loc {
 ///
 /// Costs, with `k` objects per cell: insert/remove/update O(1) (amortized);
 /// pairs O(cells + Σ k·(neighbours' k) + large × query); range queries O(cells in
-/// the range + objects there + large). Memory: 16 bytes per cell, 8 per
+/// the range + objects there + large). Frusta (which have no bounding box) and
+/// ranges of more than a few dozen cells descend an implicit octree of cell
+/// blocks instead: blocks outside the query are skipped and blocks whose
+/// centres lie inside it are reported without tests (see `query`), so a
+/// frustum costs O(blocks near its boundary + objects inside), not O(cells). Memory: 16 bytes per cell, 8 per
 /// object for its location, 16 for its sphere, plus the payloads.
 #[derive(Clone, Debug)]
 pub struct UniformGrid3d<T> {

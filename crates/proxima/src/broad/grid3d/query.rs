@@ -7,10 +7,26 @@ use crate::broad::Selection;
 use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
 use std::ops::ControlFlow;
 
+/// Ranges of at most this many cells are visited row by row without the block
+/// descent (a small sphere or box query: classifying blocks would cost more
+/// than it saves).
+const FLAT_CELLS: u64 = 64;
+
+/// Blocks of at most this many cells are not split further: their rows are
+/// visited cell by cell.
+const LEAF_CELLS: u64 = 8;
+
+/// Number of cells in the block `[lo, hi]`.
+#[inline]
+fn block_cells(lo: [u32; 3], hi: [u32; 3]) -> u64 {
+    (0..3).map(|a| (hi[a] - lo[a]) as u64 + 1).product()
+}
+
 impl<T> UniformGrid3d<T> {
     /// Reports the gridded objects selected by `q` in the cells `[lo, hi]`
-    /// (inclusive). Cells holding several objects are first classified by their
-    /// loose box: `Outside` skips them, `Inside` reports without exact tests.
+    /// (inclusive). Small ranges are scanned row by row; larger ones (frusta,
+    /// which give no bounding box, and large spheres or boxes) are descended as
+    /// an implicit octree of cell blocks (see [`Self::visit_block`]).
     pub(super) fn visit_range<Q: Selection + ?Sized>(
         &self,
         q: &Q,
@@ -18,20 +34,100 @@ impl<T> UniformGrid3d<T> {
         hi: [u32; 3],
         f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
+        if block_cells(lo, hi) > FLAT_CELLS {
+            return self.visit_block(q, lo, hi, Frustum::ALL_PLANES, f);
+        }
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
-                self.visit_row(q, [lo[0], y, z], hi[0], f)?;
+                self.visit_row(q, [lo[0], y, z], hi[0], Frustum::ALL_PLANES, f)?;
             }
         }
         ControlFlow::Continue(())
     }
 
-    /// The cells `start.x ..= x1` of one row.
+    /// The cells `[lo, hi]` as one block: its box of centres and its loose box
+    /// (every gridded sphere whose centre is in the block lies inside it) are
+    /// classified with [`Selection::classify_centres`] over the planes in
+    /// `mask`; `Outside` skips the block, `Inside` reports all of its objects
+    /// without exact tests (valid by that method's contract), and
+    /// `Intersecting` splits the block in two along its longest axis, passing
+    /// down the planes that still cut it (plane masking, as in a BVH), until
+    /// blocks of [`LEAF_CELLS`] are scanned cell by cell. This is the frustum
+    /// culling of a hierarchy (design §5, W4) over the dense grid, with no
+    /// stored tree: cost O(blocks near the query's boundary + cells inside it).
+    fn visit_block<Q: Selection + ?Sized>(
+        &self,
+        q: &Q,
+        lo: [u32; 3],
+        hi: [u32; 3],
+        mask: u8,
+        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        let single = block_cells(lo, hi) == 1;
+        if single && self.store.count(self.geom.index(lo)) == 0 {
+            return ControlFlow::Continue(());
+        }
+        let g = &self.geom;
+        let (rel, mask) = q.classify_centres(&g.centre_block(lo, hi), &g.loose_block(lo, hi), mask);
+        match rel {
+            Relation::Outside => ControlFlow::Continue(()),
+            Relation::Inside => self.report_block(lo, hi, f),
+            Relation::Intersecting if single => {
+                self.test_cell(q, self.geom.index(lo), Relation::Intersecting, mask, f)
+            }
+            Relation::Intersecting if block_cells(lo, hi) <= LEAF_CELLS => {
+                for z in lo[2]..=hi[2] {
+                    for y in lo[1]..=hi[1] {
+                        self.visit_row(q, [lo[0], y, z], hi[0], mask, f)?;
+                    }
+                }
+                ControlFlow::Continue(())
+            }
+            Relation::Intersecting => {
+                let a = (0..3).max_by_key(|&a| hi[a] - lo[a]).unwrap_or(0);
+                let mid = lo[a] + (hi[a] - lo[a]) / 2;
+                let (mut h1, mut l2) = (hi, lo);
+                h1[a] = mid;
+                l2[a] = mid + 1;
+                self.visit_block(q, lo, h1, mask, f)?;
+                self.visit_block(q, l2, hi, mask, f)
+            }
+        }
+    }
+
+    /// Reports every gridded object in the cells `[lo, hi]`, without tests.
+    fn report_block(
+        &self,
+        lo: [u32; 3],
+        hi: [u32; 3],
+        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                let first = self.geom.index([lo[0], y, z]);
+                for c in first..=first + (hi[0] - lo[0]) {
+                    for part in self.store.parts(c) {
+                        for &slot in part {
+                            let (h, v) = self.resolve(slot);
+                            f(h, &self.spheres[slot as usize], v)?;
+                        }
+                    }
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// The cells `start.x ..= x1` of one row. Cells holding several objects are
+    /// first classified by their centres and loose box over the planes in `mask` (those that
+    /// may still cut them): `Outside` skips them, `Inside` reports without exact
+    /// tests.
     fn visit_row<Q: Selection + ?Sized>(
         &self,
         q: &Q,
         start: [u32; 3],
         x1: u32,
+        mask: u8,
         f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let first = self.geom.index(start);
@@ -42,19 +138,39 @@ impl<T> UniformGrid3d<T> {
             }
             let mut rel = Relation::Intersecting;
             if n > 2 {
-                let b = self.geom.loose([x, start[1], start[2]]);
-                rel = q.classify_box(&b, Frustum::ALL_PLANES).0;
+                let c = [x, start[1], start[2]];
+                let g = &self.geom;
+                rel = q
+                    .classify_centres(&g.centre_block(c, c), &g.loose(c), mask)
+                    .0;
                 if rel == Relation::Outside {
                     continue;
                 }
             }
-            for part in self.store.parts(c) {
-                for &slot in part {
-                    let s = &self.spheres[slot as usize];
-                    if rel == Relation::Inside || q.selects(s) {
-                        let (h, v) = self.resolve(slot);
-                        f(h, s, v)?;
-                    }
+            self.test_cell(q, c, rel, mask, f)?;
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Reports the objects of cell `c` selected by `q`: all of them if `rel`
+    /// is `Inside`, else those passing the exact test over the planes in
+    /// `mask` (the others keep every sphere of the cell).
+    // Always inlined: the loop body of the small-range row scan.
+    #[inline(always)]
+    fn test_cell<Q: Selection + ?Sized>(
+        &self,
+        q: &Q,
+        c: u32,
+        rel: Relation,
+        mask: u8,
+        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        for part in self.store.parts(c) {
+            for &slot in part {
+                let s = &self.spheres[slot as usize];
+                if rel == Relation::Inside || q.selects_masked(s, mask) {
+                    let (h, v) = self.resolve(slot);
+                    f(h, s, v)?;
                 }
             }
         }
@@ -112,7 +228,13 @@ impl<T> UniformGrid3d<T> {
                 let Some((x0, x1, _)) = span(&restrict(&bk, 1, j), 0) else {
                     continue;
                 };
-                self.visit_row(ray, [g.coord(x0, 0), j, k], g.coord(x1, 0), f)?;
+                self.visit_row(
+                    ray,
+                    [g.coord(x0, 0), j, k],
+                    g.coord(x1, 0),
+                    Frustum::ALL_PLANES,
+                    f,
+                )?;
             }
         }
         ControlFlow::Continue(())
@@ -123,9 +245,163 @@ impl<T> UniformGrid3d<T> {
 mod tests {
     use crate::broad::test_util::check_ray;
     use crate::broad::{BruteForce, SpatialIndex, UniformGrid3d};
-    use crate::geom::{Aabb, Ray, Sphere};
-    use glam::{vec3, Vec3};
+    use crate::geom::{Aabb, Frustum, Plane, Ray, Sphere};
+    use glam::{vec3, Mat4, Vec3};
     use rand::{Rng, SeedableRng};
+    use std::ops::ControlFlow;
+
+    /// Payload ids of `hits`, sorted.
+    fn ids<I: SpatialIndex<u32>>(index: &I, hits: Vec<crate::arena::Handle>) -> Vec<u32> {
+        let mut v: Vec<u32> = hits.iter().map(|h| *index.get(*h).unwrap().1).collect();
+        v.sort_unstable();
+        v
+    }
+
+    fn rand_vec(rng: &mut impl Rng, lo: f32, hi: f32) -> Vec3 {
+        vec3(
+            rng.gen_range(lo..hi),
+            rng.gen_range(lo..hi),
+            rng.gen_range(lo..hi),
+        )
+    }
+
+    /// A frustum of a random kind: a perspective or orthographic camera at any
+    /// position and orientation, random inward planes (often empty or
+    /// unbounded), or a degenerate matrix (zero rows: planes with zero normals).
+    fn rand_frustum(rng: &mut impl Rng) -> Frustum {
+        let eye = rand_vec(rng, -20.0, 50.0);
+        let mut at = rand_vec(rng, -20.0, 50.0);
+        if at == eye {
+            at.x += 1.0;
+        }
+        let up = if rng.gen_bool(0.5) { Vec3::Y } else { Vec3::Z };
+        let up = if (at - eye).normalize().cross(up).length() < 1e-3 {
+            Vec3::X
+        } else {
+            up
+        };
+        let view = Mat4::look_at_rh(eye, at, up);
+        match rng.gen_range(0..5) {
+            0 | 1 => {
+                let fov = rng.gen_range(0.01..3.0);
+                let near = rng.gen_range(0.01..5.0);
+                let far = near + rng.gen_range(0.01..80.0);
+                let p = Mat4::perspective_rh(fov, rng.gen_range(0.2..4.0), near, far);
+                Frustum::from_view_projection(p * view).unwrap()
+            }
+            2 => {
+                let (w, h) = (rng.gen_range(0.01..40.0), rng.gen_range(0.01..40.0));
+                let p = Mat4::orthographic_rh(-w, w, -h, h, rng.gen_range(-10.0..1.0), 40.0);
+                Frustum::from_view_projection(p * view).unwrap()
+            }
+            3 => Frustum::from_planes([0; 6].map(|_| {
+                let n = rand_vec(rng, -1.0, 1.0).normalize_or(Vec3::X);
+                Plane::new(n, -n.dot(rand_vec(rng, -10.0, 40.0)))
+            })),
+            _ => {
+                let mut m = Mat4::perspective_rh(1.0, 1.5, 0.5, 30.0) * view;
+                // Zero some rows: planes with zero normals (everywhere in or out).
+                let mut rows = [m.row(0), m.row(1), m.row(2), m.row(3)];
+                for r in rows.iter_mut() {
+                    if rng.gen_bool(0.4) {
+                        *r = glam::Vec4::ZERO;
+                    }
+                }
+                m = Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
+                Frustum::from_view_projection(m).unwrap()
+            }
+        }
+    }
+
+    /// The block descent (frusta; spheres and boxes spanning more than a few
+    /// cells) and the cell-by-cell path against brute force, over grids of every
+    /// shape, crowded and sparse cells (spills), centres outside the world,
+    /// large objects, and queries tiny, huge, inside, outside and straddling.
+    #[test]
+    fn block_descent_matches_brute_force() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
+        let shapes = [
+            (vec3(30.0, 30.0, 30.0), 3.0),
+            (vec3(30.0, 3.0, 30.0), 3.0),
+            (vec3(60.0, 2.0, 2.0), 2.0),
+            (vec3(5.0, 5.0, 5.0), 10.0),
+            (vec3(30.0, 30.0, 30.0), 1.5),
+        ];
+        for (ext, cell) in shapes {
+            let w = Aabb::new(Vec3::ZERO, ext);
+            let mut g = UniformGrid3d::with_cell_size(w, cell).unwrap();
+            let mut b = BruteForce::new();
+            let lim = 0.49 * g.cell_size();
+            for i in 0..600u32 {
+                // Crowded clusters (spills) and spread centres, some outside.
+                let c = if i % 3 == 0 {
+                    vec3(7.0, 1.0, 7.0) + rand_vec(&mut rng, -1.0, 1.0)
+                } else {
+                    rand_vec(&mut rng, -10.0, 40.0)
+                };
+                let r = match i % 50 {
+                    0 => 6.0,
+                    1 => 0.0,
+                    2 => lim,
+                    _ => rng.gen_range(0.0..lim),
+                };
+                g.insert(Sphere::new(c, r), i).unwrap();
+                b.insert(Sphere::new(c, r), i).unwrap();
+            }
+            g.validate().unwrap();
+            for k in 0..150 {
+                let fr = rand_frustum(&mut rng);
+                assert_eq!(
+                    ids(&g, g.frustum_hits(&fr).unwrap()),
+                    ids(&b, b.frustum_hits(&fr).unwrap()),
+                    "{fr:?}"
+                );
+                let scale = [0.01, 1.0, 5.0, 20.0, 200.0][k % 5];
+                let q = Sphere::new(rand_vec(&mut rng, -15.0, 45.0), rng.gen_range(0.0..scale));
+                assert_eq!(
+                    ids(&g, g.sphere_hits(&q).unwrap()),
+                    ids(&b, b.sphere_hits(&q).unwrap()),
+                    "{q:?}"
+                );
+                let c = rand_vec(&mut rng, -15.0, 45.0);
+                let h = rand_vec(&mut rng, 0.0, scale);
+                let q = Aabb::new(c - h, c + h);
+                assert_eq!(
+                    ids(&g, g.aabb_hits(&q).unwrap()),
+                    ids(&b, b.aabb_hits(&q).unwrap()),
+                    "{q:?}"
+                );
+            }
+        }
+    }
+
+    /// A visit stopped by the callback reports nothing more, on the block path.
+    #[test]
+    fn block_descent_stops_early() {
+        let w = Aabb::new(Vec3::ZERO, Vec3::splat(30.0));
+        let mut g = UniformGrid3d::with_cell_size(w, 3.0).unwrap();
+        for i in 0..500u32 {
+            let c = vec3(
+                (i % 10) as f32 * 3.0,
+                (i / 10 % 10) as f32 * 3.0,
+                (i / 100) as f32,
+            );
+            g.insert(Sphere::new(c, 1.0), i).unwrap();
+        }
+        let big = Sphere::new(Vec3::splat(15.0), 100.0);
+        for stop in [1, 7, 499] {
+            let mut n = 0;
+            let r = g.visit(&big, |_, _, _| {
+                n += 1;
+                if n == stop {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            });
+            assert_eq!((r, n), (ControlFlow::Break(()), stop));
+        }
+    }
 
     #[test]
     fn rays_and_ranges_match_brute_force() {

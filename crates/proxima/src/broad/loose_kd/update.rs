@@ -45,7 +45,7 @@ impl<T> LooseKdTree<T> {
         let max_depth = self.max_depth;
         let n = &self.nodes[loc.node];
         if n.routes(&s) && (s.radius >= n.h || n.depth >= max_depth) {
-            self.store.sphere[(n.start + loc.pos) as usize] = s;
+            self.store.set((n.start + loc.pos) as usize, s);
             return;
         }
         let (_, handle, value) = self.take(loc);

@@ -88,6 +88,7 @@ impl<T> LooseKdTree<T> {
             self.store.disorder += 1;
             let n = &mut self.nodes[node];
             n.start = at;
+            n.loose = false;
             n.cap = new_cap;
             at
         };
@@ -155,6 +156,7 @@ impl<T> LooseKdTree<T> {
                 }
                 node.start = at;
                 node.cap = room_for(node.len);
+                node.loose = false;
                 node.parent = parent;
                 let children = node.child;
                 node.child = [NIL, NIL];

@@ -135,13 +135,13 @@ impl<T> LooseKdTree<T> {
             // The node's own objects after its children are classified: the
             // children's tests need only this node's fields, and the scan's
             // first load (the node's range of the object array) is the miss.
-            self.scan(node.range(), query, p.mask, &mut f)?;
+            self.scan(node.range(), node.loose, query, p.mask, &mut f)?;
         }
         ControlFlow::Continue(())
     }
 
     /// Reports every object at positions `range`, without tests.
-    #[inline]
+    #[inline(always)]
     fn report_all(
         &self,
         range: Range<usize>,
@@ -161,11 +161,13 @@ impl<T> LooseKdTree<T> {
     /// sphere. `mask` is the node's frustum plane mask: the masked-off planes
     /// contain the node's region, hence its objects, even where a chunk's bound
     /// also covers a neighbouring range. Short ranges are tested directly (a
-    /// chunk test costs about as much as two sphere tests).
-    #[inline]
+    /// chunk test costs about as much as two sphere tests), and so are the
+    /// objects of a `loose` node (its bounds may miss moved objects).
+    #[inline(always)]
     fn scan<Q: Selection + ?Sized>(
         &self,
         range: Range<usize>,
+        loose: bool,
         query: &Q,
         mask: u8,
         f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
@@ -173,7 +175,7 @@ impl<T> LooseKdTree<T> {
         let mut p = range.start;
         while p < range.end {
             let end = ((p / CHUNK + 1) * CHUNK).min(range.end);
-            if end - p > 2 {
+            if !loose && end - p > 2 {
                 let c = &self.store.chunk[p / CHUNK];
                 let e = Vec3::splat(self.eps);
                 let b = Aabb::new(c.min - e, c.max + e);
@@ -190,13 +192,26 @@ impl<T> LooseKdTree<T> {
                     Relation::Intersecting => {}
                 }
             }
-            for (q, s) in (p..end).zip(&self.store.sphere[p..end]) {
-                if query.selects(s) {
-                    let (h, v) = self.store.at(q);
-                    f(h, s, v)?;
-                }
-            }
+            self.test_each(p..end, query, f)?;
             p = end;
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Reports the objects at positions `range` that `query` selects, testing
+    /// each one.
+    #[inline(always)]
+    fn test_each<Q: Selection + ?Sized>(
+        &self,
+        range: Range<usize>,
+        query: &Q,
+        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        for (q, s) in range.clone().zip(&self.store.sphere[range]) {
+            if query.selects(s) {
+                let (h, v) = self.store.at(q);
+                f(h, s, v)?;
+            }
         }
         ControlFlow::Continue(())
     }

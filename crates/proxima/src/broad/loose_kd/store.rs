@@ -15,8 +15,12 @@
 //! O(objects + nodes), rare, and it restores the depth-first order.
 //!
 //! Chunk bounds: every [`CHUNK`] consecutive positions share one box that
-//! contains the box of every sphere written there since the last compaction
-//! (writes only grow it; compaction rebuilds it exact). Queries test a chunk's
+//! contains the box of every sphere written there through [`Store::set`] since
+//! the last compaction (writes only grow it; compaction rebuilds it exact). A
+//! move that keeps its node writes the sphere alone (`Store::sphere` directly)
+//! and marks the node `loose` instead: keeping the bound there cost W1 one more
+//! cache miss per move (~+40% update time), and queries scan a loose node
+//! without its chunk bounds until the next compaction or relocation. Queries test a chunk's
 //! box before its spheres: a W4 profile showed the queries spend their time
 //! scanning nodes of ~100 objects one sphere at a time (density 0.15 stops a
 //! sphere of radius `r` in a cell ~27·r wide), and most chunks of such a node
@@ -35,10 +39,11 @@ pub(super) const CHUNK: usize = 8;
 /// past a node's `len` hold an old sphere and `None`.
 #[derive(Clone, Debug)]
 pub(super) struct Store<T> {
-    /// Read freely; written only through [`Store::set`], which keeps `chunk`.
+    /// Written through [`Store::set`], which keeps `chunk`, except by in-place
+    /// moves, which mark their node `loose` instead.
     pub sphere: Vec<Sphere>,
-    /// `chunk[p / CHUNK]` contains `sphere[p].aabb()` for every position `p`
-    /// written since the last compaction.
+    /// `chunk[p / CHUNK]` contains `sphere[p].aabb()` for every live position
+    /// `p` of a node that is not `loose`.
     pub chunk: Vec<Aabb>,
     pub entry: Vec<Option<(Handle, T)>>,
     /// Positions in ranges no node owns any more (freed nodes, moved ranges).

@@ -471,6 +471,17 @@ fn chunk_bounds_prune_exactly_under_moves_removals_and_odd_queries() {
         };
         Sphere::new(c, r)
     };
+    let loose = |t: &LooseKdTree<u32>| {
+        let (mut stack, mut k) = (vec![t.root], 0);
+        while let Some(n) = stack.pop() {
+            if n != NIL {
+                k += t.nodes[n].loose as usize;
+                stack.extend(t.nodes[n].child);
+            }
+        }
+        k
+    };
+    let mut loose_frames = 0;
     for frame in 0..30 {
         // Inserts, then moves (mostly small: bounds grow in place), then removals.
         for _ in 0..400 {
@@ -499,13 +510,26 @@ fn chunk_bounds_prune_exactly_under_moves_removals_and_odd_queries() {
                 b.update(*bh, *s).unwrap();
             }
         }
+        loose_frames += (loose(&t) > 0) as usize;
         for _ in 0..250 {
             let i = rng.gen_range(0..objs.len());
             let (th, bh, _, id) = objs.swap_remove(i);
             assert_eq!(t.remove(th).unwrap(), id);
             assert_eq!(b.remove(bh).unwrap(), id);
         }
+        // Both query paths: nodes made loose by in-place moves (tested object by
+        // object) and, after a compaction, exact chunk bounds (then grown by
+        // the inserts, swap-removals and relocations of the next frame).
+        if frame % 2 == 1 {
+            t.compact();
+            assert_eq!(loose(&t), 0);
+        }
         t.validate().unwrap();
+        // Queries at objects' current centres: a moved object outside a stale
+        // chunk bound would be missed by them.
+        let near: Vec<Vec3> = (0..120)
+            .map(|_| objs[rng.gen_range(0..objs.len())].2.center)
+            .collect();
         let mut p = || {
             Vec3::new(
                 rng.gen_range(-10.0..side + 10.0),
@@ -513,9 +537,12 @@ fn chunk_bounds_prune_exactly_under_moves_removals_and_odd_queries() {
                 rng.gen_range(-10.0..side + 10.0),
             )
         };
-        for k in 0..60 {
-            let c = p();
-            let r = [0.0, 1e-6, 1.0, 3.0, 12.0, 1e4][k % 6];
+        for k in 0..180 {
+            let (c, r) = if k < 60 {
+                (p(), [0.0, 1e-6, 1.0, 3.0, 12.0, 1e4][k % 6])
+            } else {
+                (near[k - 60], [0.0, 1e-6, 0.05, 0.3, 1.0, 3.0][k % 6])
+            };
             let q = Sphere::new(c, r);
             assert_eq!(selected(&t, &q), selected(&b, &q), "sphere {q:?}");
             let h = Vec3::new(r, 0.5 * r, 2.0 * r);
@@ -539,4 +566,5 @@ fn chunk_bounds_prune_exactly_under_moves_removals_and_odd_queries() {
             }
         }
     }
+    assert!(loose_frames > 10, "moves rarely made a node loose");
 }

@@ -81,18 +81,19 @@ impl<T> LooseKdTree<T> {
             let at = self.store.grow(new_cap as usize);
             for i in 0..len as usize {
                 let (from, to) = (start as usize + i, at as usize + i);
-                self.store.sphere[to] = self.store.sphere[from];
+                self.store.set(to, self.store.sphere[from]);
                 self.store.entry[to] = self.store.entry[from].take();
             }
             self.store.dead += cap as usize;
             self.store.disorder += 1;
             let n = &mut self.nodes[node];
             n.start = at;
+            n.loose = false;
             n.cap = new_cap;
             at
         };
         let p = (start + len) as usize;
-        self.store.sphere[p] = sphere;
+        self.store.set(p, sphere);
         self.store.entry[p] = Some((handle, value));
         self.nodes[node].len = len + 1;
         *self
@@ -111,7 +112,7 @@ impl<T> LooseKdTree<T> {
         let sphere = self.store.sphere[p];
         let (handle, value) = self.store.entry[p].take().expect("live position");
         if p != last {
-            self.store.sphere[p] = self.store.sphere[last];
+            self.store.set(p, self.store.sphere[last]);
             let moved = self.store.entry[last].take();
             let idx = moved.as_ref().expect("live position").0.index();
             self.store.entry[p] = moved;
@@ -150,11 +151,12 @@ impl<T> LooseKdTree<T> {
                 let at = store.grow(room_for(node.len) as usize);
                 for i in 0..node.len as usize {
                     let from = node.start as usize + i;
-                    store.sphere[at as usize + i] = self.store.sphere[from];
+                    store.set(at as usize + i, self.store.sphere[from]);
                     store.entry[at as usize + i] = self.store.entry[from].take();
                 }
                 node.start = at;
                 node.cap = room_for(node.len);
+                node.loose = false;
                 node.parent = parent;
                 let children = node.child;
                 node.child = [NIL, NIL];

@@ -100,7 +100,10 @@ struct Loc {
 /// Memory: one node per occupied cell (`size_of` = 128 bytes, one cache-line-aligned
 /// block); the objects (sphere, handle, payload) of all nodes share one array in
 /// which each node owns a contiguous range with some spare room (up to ~1.5 spare or
-/// dead positions per object, see `store.rs`), plus one small arena slot per object
+/// dead positions per object, see `store.rs`; one 24-byte bound per 8
+/// positions lets queries skip most of a node's objects; a move inside a node
+/// does not update it but marks the node for full scans until the next
+/// compaction or relocation of its range), plus one small arena slot per object
 /// giving its node and position. Nodes live in a pooled arena with a free list; the
 /// array and the nodes are periodically compacted into depth-first order, which is
 /// the order the pair search and the queries read them in. Insert and a move that leaves the node's

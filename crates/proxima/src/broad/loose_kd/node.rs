@@ -32,6 +32,10 @@ pub(super) struct Node {
     /// Split axis: the longest of `bbox` (ties to the lower index, as in the seed).
     pub axis: u8,
     pub depth: u8,
+    /// Set by a move that kept its node without growing its chunk bound: the
+    /// chunk bounds of this node's range may miss its objects (`store.rs`), so
+    /// queries test every object. Cleared when the range is rewritten.
+    pub loose: bool,
     /// The parent's `h` (∞ at the root): a sphere is routed here only if `r < h_up`.
     /// `h` never grows downwards, so this is the smallest `h` on the path.
     pub h_up: f32,
@@ -74,6 +78,7 @@ impl Node {
             cap: 0,
             axis,
             depth,
+            loose: false,
         }
     }
 

@@ -2,28 +2,35 @@
 //! front-to-back first-hit ray search.
 
 use super::node::{FixedStack, NIL};
+use super::store::CHUNK;
 use super::LooseKdTree;
 use crate::arena::Handle;
 use crate::broad::{RayHit, Selection};
-use crate::geom::{overlap, Frustum, Ray, Relation, Sphere};
-use std::ops::ControlFlow;
+use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
+use glam::Vec3;
+use std::ops::{ControlFlow, Range};
 
-/// A pending node: index, frustum plane mask, and whether its whole region is
-/// known to be selected (then its subtree is reported without tests).
-#[derive(Clone, Copy, Default)]
+/// A pending node: index, frustum plane mask, whether its whole region is known
+/// to be selected (then its subtree is reported without tests), and its box `B`
+/// (derived from the parent's, equal to the node's own `bbox`, which `validate`
+/// checks): carrying it means a walk reads only a node's first cache line.
+#[derive(Clone, Copy)]
 struct Pending {
     node: u32,
     mask: u8,
     inside: bool,
+    bbox: Aabb,
 }
 
-/// A subtree known to be wholly selected.
-#[inline]
-fn p_inside(node: u32) -> Pending {
-    Pending {
-        node,
-        mask: 0,
-        inside: true,
+/// Filler of the fixed stack's unused entries.
+impl Default for Pending {
+    fn default() -> Self {
+        Pending {
+            node: NIL,
+            mask: 0,
+            inside: false,
+            bbox: Aabb::EMPTY,
+        }
     }
 }
 
@@ -55,36 +62,42 @@ impl<T> LooseKdTree<T> {
         }
         let bounds = query.bounds();
         let mut stack = FixedStack::<Pending>::new();
-        let push =
-            |node: u32, (rel, mask): (Relation, u8), stack: &mut FixedStack<Pending>| match rel {
-                Relation::Outside => {}
-                Relation::Inside => stack.push(Pending {
-                    node,
-                    mask: 0,
-                    inside: true,
-                }),
-                Relation::Intersecting => stack.push(Pending {
-                    node,
-                    mask,
-                    inside: false,
-                }),
+        let push = |node: u32,
+                    bbox: Aabb,
+                    (rel, mask): (Relation, u8),
+                    stack: &mut FixedStack<Pending>|
+         -> bool {
+            let inside = match rel {
+                Relation::Outside => return false,
+                Relation::Inside => true,
+                Relation::Intersecting => false,
             };
+            stack.push(Pending {
+                node,
+                mask: if inside { 0 } else { mask },
+                inside,
+                bbox,
+            });
+            true
+        };
         let root = &self.nodes[self.root];
-        push(
+        let _ = push(
             self.root,
+            root.bbox,
             query.classify_box(&self.region(root), Frustum::ALL_PLANES),
             &mut stack,
         );
         while let Some(p) = stack.pop() {
             let node = &self.nodes[p.node];
             if p.inside {
-                for (q, s) in node.range().zip(&self.store.sphere[node.range()]) {
-                    let (h, v) = self.store.at(q);
-                    f(h, s, v)?;
-                }
+                self.report_all(node.range(), &mut f)?;
                 for c in node.child {
                     if c != NIL {
-                        stack.push(p_inside(c));
+                        stack.push(Pending {
+                            node: c,
+                            inside: true,
+                            ..p
+                        });
                     }
                 }
                 continue;
@@ -106,26 +119,98 @@ impl<T> LooseKdTree<T> {
                     }
                 }
                 // The child's box, from the parent: one face moved to `m ∓ h`.
-                let mut cb = node.bbox;
+                let mut cb = p.bbox;
                 if side == 1 {
                     cb.min[a] = node.m - node.h;
                 } else {
                     cb.max[a] = node.m + node.h;
                 }
-                push(
-                    c,
-                    query.classify_box(&self.region_of_box(&cb), p.mask),
-                    &mut stack,
-                );
+                let region = self.region_of_box(&cb);
+                if push(c, cb, query.classify_box(&region, p.mask), &mut stack) {
+                    // Start loading the child now, so that the load overlaps the
+                    // scan of this node's objects instead of stalling the next pop.
+                    std::hint::black_box(self.nodes[c].start);
+                }
             }
             // The node's own objects after its children are classified: the
             // children's tests need only this node's fields, and the scan's
             // first load (the node's range of the object array) is the miss.
-            for (q, s) in node.range().zip(&self.store.sphere[node.range()]) {
-                if query.selects(s) {
-                    let (h, v) = self.store.at(q);
-                    f(h, s, v)?;
+            self.scan(node.range(), node.loose, query, p.mask, &mut f)?;
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Reports every object at positions `range`, without tests.
+    #[inline(always)]
+    fn report_all(
+        &self,
+        range: Range<usize>,
+        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        for (q, s) in range.clone().zip(&self.store.sphere[range]) {
+            let (h, v) = self.store.at(q);
+            f(h, s, v)?;
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Reports the objects at positions `range` (one node's) that `query`
+    /// selects, chunk by chunk: a chunk whose bound (`store.rs`, plus the slack
+    /// `eps`) the query classifies `Outside` is skipped unread, one it classifies
+    /// `Inside` is reported without tests, the others are tested sphere by
+    /// sphere. `mask` is the node's frustum plane mask: the masked-off planes
+    /// contain the node's region, hence its objects, even where a chunk's bound
+    /// also covers a neighbouring range. Short ranges are tested directly (a
+    /// chunk test costs about as much as two sphere tests), and so are the
+    /// objects of a `loose` node (its bounds may miss moved objects).
+    #[inline(always)]
+    fn scan<Q: Selection + ?Sized>(
+        &self,
+        range: Range<usize>,
+        loose: bool,
+        query: &Q,
+        mask: u8,
+        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        let mut p = range.start;
+        while p < range.end {
+            let end = ((p / CHUNK + 1) * CHUNK).min(range.end);
+            if !loose && end - p > 2 {
+                let c = &self.store.chunk[p / CHUNK];
+                let e = Vec3::splat(self.eps);
+                let b = Aabb::new(c.min - e, c.max + e);
+                match query.classify_box(&b, mask).0 {
+                    Relation::Outside => {
+                        p = end;
+                        continue;
+                    }
+                    Relation::Inside => {
+                        self.report_all(p..end, f)?;
+                        p = end;
+                        continue;
+                    }
+                    Relation::Intersecting => {}
                 }
+            }
+            self.test_each(p..end, query, f)?;
+            p = end;
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Reports the objects at positions `range` that `query` selects, testing
+    /// each one.
+    #[inline(always)]
+    fn test_each<Q: Selection + ?Sized>(
+        &self,
+        range: Range<usize>,
+        query: &Q,
+        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        for (q, s) in range.clone().zip(&self.store.sphere[range]) {
+            if query.selects(s) {
+                let (h, v) = self.store.at(q);
+                f(h, s, v)?;
             }
         }
         ControlFlow::Continue(())

@@ -45,7 +45,11 @@ impl<T> LooseKdTree<T> {
         let max_depth = self.max_depth;
         let n = &self.nodes[loc.node];
         if n.routes(&s) && (s.radius >= n.h || n.depth >= max_depth) {
-            self.store.sphere[(n.start + loc.pos) as usize] = s;
+            let p = (n.start + loc.pos) as usize;
+            if !n.loose {
+                self.nodes[loc.node].loose = true;
+            }
+            self.store.sphere[p] = s;
             return;
         }
         let (_, handle, value) = self.take(loc);

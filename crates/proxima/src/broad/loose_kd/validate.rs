@@ -1,6 +1,7 @@
 //! `validate()`: every structural invariant, checked from scratch.
 
 use super::node::{all_space, slack, split_of, NIL};
+use super::store::CHUNK;
 use super::LooseKdTree;
 use crate::{Error, Result};
 
@@ -29,6 +30,9 @@ impl<T> LooseKdTree<T> {
                 return fail(format!("node slot {i} freed twice"));
             }
             *seen = true;
+        }
+        if self.store.chunk.len() != self.store.sphere.len().div_ceil(CHUNK) {
+            return fail("chunk bounds do not match the object array".into());
         }
         if self.store.sphere.len() != self.store.entry.len() {
             return fail("object array columns differ in length".into());
@@ -129,6 +133,10 @@ impl<T> LooseKdTree<T> {
                 }
                 if !self.span.contains_aabb(&s.aabb()) {
                     return fail(format!("object in node {n} outside span"));
+                }
+                // Queries skip a chunk on its bound (`store.rs`).
+                if !node.loose && !self.store.chunk[p / CHUNK].contains_aabb(&s.aabb()) {
+                    return fail(format!("object at {p} outside its chunk bound"));
                 }
             }
             items_seen += node.len as usize;

@@ -3,16 +3,24 @@
 use super::keys::KeyBox;
 use super::HashGrid;
 use crate::arena::Handle;
-use crate::geom::overlap;
+use crate::geom::{overlap, Sphere};
 use std::ops::ControlFlow;
+
+/// `overlap::sphere_sphere_candidate` on two stored spheres.
+#[inline(always)]
+fn candidate(a: &Sphere, b: &Sphere) -> bool {
+    let (p, q) = (a.center, b.center);
+    overlap::sphere_sphere_candidate(p.x, p.y, p.z, a.radius, q.x, q.y, q.z, b.radius)
+}
 
 impl<T> HashGrid<T> {
     /// Calls `f` once per overlapping pair.
     ///
     /// Gridded pairs: two overlapping objects share a cell; the pair is reported
     /// only from the lowest cell both cover (`max` of their lowest cells per axis),
-    /// checked before the sphere test so that each pair is sphere-tested once,
-    /// however many cells it shares. Pairs with an oversized object: each
+    /// checked after the `f32` pre-filter and before the exact test, so that each
+    /// pair gets the exact test once however many cells it shares (see
+    /// `UniformGrid2d`'s pair search for why this order). Pairs with an oversized object: each
     /// oversized object against the others after it in the list, then a grid query
     /// with its sphere (each gridded object once, by the query's own rule). Cost
     /// O(Σ k² + oversized² + oversized × query).
@@ -29,10 +37,12 @@ impl<T> HashGrid<T> {
             for (i, ea) in es.iter().enumerate() {
                 let sa = &self.spheres[ea.slot as usize];
                 for eb in &es[i + 1..] {
-                    if ea.lo[0].max(eb.lo[0]) == key[0]
+                    let sb = &self.spheres[eb.slot as usize];
+                    if candidate(sa, sb)
+                        && ea.lo[0].max(eb.lo[0]) == key[0]
                         && ea.lo[1].max(eb.lo[1]) == key[1]
                         && ea.lo[2].max(eb.lo[2]) == key[2]
-                        && overlap::sphere_sphere(sa, &self.spheres[eb.slot as usize])
+                        && overlap::sphere_sphere(sa, sb)
                     {
                         let (ha, va) = self.resolve(ea.slot);
                         let (hb, vb) = self.resolve(eb.slot);

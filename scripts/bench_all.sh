@@ -1,0 +1,35 @@
+#!/bin/bash
+# Regenerates docs/bench/* (the raw outputs behind BENCHMARKS.md) from the
+# release bench binary. Run from the repo root after
+# `cargo build --release -p proxima-bench`; takes about 6 minutes on 2 cores.
+set -e
+B=./target/release/proxima-bench
+D=docs/bench
+uptime > $D/load.txt
+$B w1 --n 10000  --frames 30 --json > $D/w1-10k.json 2>/dev/null
+$B w1 --n 100000 --frames 30 --json > $D/w1-100k.json 2>/dev/null
+$B w2 --n 100000 --frames 30 --json > $D/w2-100k.json 2>/dev/null
+$B w3 --n 100000 --frames 30 --json > $D/w3-100k.json 2>/dev/null
+uptime >> $D/load.txt
+for t in 1 2; do $B w1 --n 100000 --frames 30 --clock wall --threads $t --only LooseKdTree,UniformGrid3d,parry3d --json > $D/w1-100k-wall-t$t.json 2>/dev/null; done
+$B w4 > $D/w4.txt 2>/dev/null
+$B w4 --json > $D/w4.json 2>/dev/null
+$B w4 --threads 2 --clock wall --only UniformGrid3d,LinearOctree,LooseKdTree,rstar,parry3d > $D/w4-wall-t2.txt 2>/dev/null
+$B w4 --threads 1 --clock wall --only UniformGrid3d,LinearOctree,LooseKdTree,rstar,parry3d > $D/w4-wall-t1.txt 2>/dev/null
+uptime >> $D/load.txt
+$B w5 > $D/w5.txt 2>/dev/null
+$B w5 --json > $D/w5.json 2>/dev/null
+$B w6 > $D/w6.txt 2>/dev/null
+$B w6 --json > $D/w6.json 2>/dev/null
+uptime >> $D/load.txt
+$B w1 --n 1000000 --frames 10 --json > $D/w1-1m.json 2>/dev/null
+uptime >> $D/load.txt
+python3 - <<'PY'
+import json
+rows=[]
+for f in ['w1-10k','w1-100k','w1-1m','w2-100k','w3-100k']:
+    rows += [r for r in json.load(open(f'docs/bench/{f}.json')) if r['structure']!='BruteForce']
+json.dump(rows, open('/tmp/w1-w3-nobrute.json','w'))
+PY
+$B chart /tmp/w1-w3-nobrute.json --out $D/w1-w3.svg --metric frame_ms_median --title "W1-W3: update all + all pairs, median frame"
+$B chart $D/w6.json --out $D/w6.svg --metric us_per_ray --title "W6: closest hit per ray"

@@ -22,6 +22,16 @@ pub struct RayHit {
     pub v: f32,
 }
 
+/// The mesh casts' ordering of hits: `(t, triangle)` of a new hit comes before
+/// `best` if it is nearer, or as near with a smaller triangle index. Both mesh
+/// casts ([`Bvh::cast_ray`], [`RayBvh`](crate::narrow::RayBvh)) keep the first hit
+/// in this order (as the tests' brute force does), so their answers never depend
+/// on the order in which triangles are tested.
+#[inline(always)]
+pub(crate) fn closer(t: f32, triangle: u32, best: Option<RayHit>) -> bool {
+    best.map_or(true, |b| t < b.t || (t == b.t && triangle < b.triangle))
+}
+
 impl<BV: BoundingVolume> Bvh<BV> {
     /// The closest hit of `ray` on `mesh` (smallest `t`; ties go to the smaller
     /// triangle index), with the watertight test of
@@ -83,11 +93,7 @@ impl<BV: BoundingVolume> Bvh<BV> {
                     let w = woop.get_or_insert_with(|| WoopRay::new(ray));
                     if let Some(h) = w.hit(&tri) {
                         let id = self.ids[k];
-                        let better = match best {
-                            None => true,
-                            Some(b) => h.t < b.t || (h.t == b.t && id < b.triangle),
-                        };
-                        if better {
+                        if closer(h.t, id, best) {
                             best = Some(RayHit {
                                 triangle: id,
                                 t: h.t,

@@ -312,7 +312,7 @@ impl RayBvh {
                 continue;
             };
             let id = self.ids[k as usize];
-            if best.map_or(true, |b| h.t < b.t || (h.t == b.t && id < b.triangle)) {
+            if super::ray::closer(h.t, id, *best) {
                 *best = Some(RayHit {
                     triangle: id,
                     t: h.t,

@@ -208,8 +208,12 @@ impl RayBvh {
             leaf[2] = self.packets.len() as u32;
             let tris = &self.tris[leaf[0] as usize..(leaf[0] + leaf[1]) as usize];
             for chunk in tris.chunks(4) {
-                let v: Vec<[Vec3A; 3]> = chunk.iter().map(|t| t.v).collect();
-                self.packets.push(TriPacket::new(&v));
+                // On the stack: `fit` runs on every refit of a deforming mesh.
+                let mut v = [[Vec3A::ZERO; 3]; 4];
+                for (d, t) in v.iter_mut().zip(chunk) {
+                    *d = t.v;
+                }
+                self.packets.push(TriPacket::new(&v[..chunk.len()]));
             }
         }
         let leaf_box = |tris: &[RayTri], [s, n, _]: [u32; 3]| {

@@ -1,7 +1,7 @@
 //! # proxima-bench
 //!
-//! Proxima's performance record for the broad phase: the standard workloads of
-//! design §5 (W1 dynamic spheres, W2 flat world, W3 clustered), run through every
+//! Proxima's performance record for the broad phase: the standard workloads
+//! [sources: workloads] (W1 dynamic spheres, W2 flat world, W3 clustered), run through every
 //! Proxima index and the peer crates side by side, with the pair count of every
 //! frame checked equal across all of them.
 //!

@@ -1,4 +1,4 @@
-//! The standard dynamic-sphere workloads of design §5 (W1, W2, W3), generated
+//! The standard dynamic-sphere workloads [sources: w1, w2, w3], generated
 //! deterministically from a seed.
 //!
 //! A workload is a set of spheres with fixed radii and per-sphere velocities. One

@@ -1,5 +1,5 @@
-//! `proxima collide A B [options]`: mesh-vs-mesh contacts with the seed's cost
-//! counters (design §4.2).
+//! `proxima collide A B [options]`: mesh-vs-mesh contacts with the cost
+//! counters [sources: bvh-cost, pose-format].
 //!
 //! ```text
 //! proxima collide A B [--bv aabb|kdop14|kdop18|kdop26|obb|sphere]

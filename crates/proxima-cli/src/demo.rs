@@ -1,5 +1,5 @@
 //! `proxima demo`, the main job and what `proxima` does without a command
-//! (design §4): a generated scene of moving spheres (design §5, W1–W3) through
+//! [sources: cli]: a generated scene of moving spheres [sources: w1, w2, w3] through
 //! every broad-phase index, with a progress bar per index, a comparison table and
 //! pictures.
 //!

@@ -125,7 +125,7 @@ pub fn loose_kd(h: &SceneHint) -> proxima::Result<LooseKdTree<u64>> {
     LooseKdTree::new(h.world, h.r_max, KD_DENSITY)
 }
 
-/// Density `d` of the loose k-d tree (design §2.1): the library's measured default.
+/// Density `d` of the loose k-d tree [sources: kd-tree]: the library's measured default.
 pub const KD_DENSITY: f32 = proxima::broad::loose_kd::DEFAULT_DENSITY;
 
 /// The linear octree as every command builds it (pictures draw this one too).

@@ -1,4 +1,4 @@
-//! `proxima`: the command-line tool of the Proxima library (design §4).
+//! `proxima`: the command-line tool of the Proxima library [sources: cli].
 //!
 //! This file only parses arguments and dispatches; each command lives in its own
 //! module, and the broad-phase indices they run are listed once in [`indices`].
@@ -41,7 +41,7 @@ enum Command {
     Demo(demo::Args),
     /// Replay a recorded scene trace against one index or all of them.
     Replay(replay::Args),
-    /// Mesh-vs-mesh contacts (exact triangle pairs) with the seed's cost counters:
+    /// Mesh-vs-mesh contacts (exact triangle pairs) with cost counters (docs/sources.md#bvh-cost):
     /// `collide A B [--bv aabb|kdop14|kdop18|kdop26|obb|sphere] [--split mean|median|sah]
     /// [--first] [--poses FILE] [--stats] [--time] [--leaf N] [--rotation auto|refit|conservative]`.
     #[command(disable_help_flag = true)]

@@ -1,6 +1,6 @@
 //! The pictures of `proxima demo` and `proxima render`: the loose k-d tree's and
-//! the octree's partitions cut by a horizontal plane (as in the figures of seeds
-//! 000 and 004), a chart of time per frame, and two posed meshes with their
+//! the octree's partitions cut by a horizontal plane (as in the figures of
+//! [sources: figures]), a chart of time per frame, and two posed meshes with their
 //! intersecting triangles.
 
 use crate::draw::{palette, Anchor, Canvas, Rgba, BLACK, GREY};
@@ -123,7 +123,7 @@ fn ramp_legend(c: &mut Canvas, x: f32, y: f32, label: &str, lo: usize, hi: usize
 /// The loose k-d tree over `spheres`, cut by the horizontal plane through the
 /// middle of the world: split lines of the nodes that plane meets, their border
 /// zones (where the two children overlap) shaded, and the spheres cut by the plane
-/// coloured by the depth of the node holding them (seed 000, figures 3–4).
+/// coloured by the depth of the node holding them [sources: figures].
 pub fn kd_partition(spheres: &[Sphere], hint: &SceneHint) -> Result<Canvas, String> {
     let mut tree = indices::loose_kd(hint).map_err(|e| e.to_string())?;
     let handles = spheres
@@ -283,8 +283,8 @@ pub fn kd_partition(spheres: &[Sphere], hint: &SceneHint) -> Result<Canvas, Stri
 
 /// The linear octree over `spheres`, cut by the horizontal plane through the
 /// middle of the world: the leaf cells the plane meets, shaded by how many objects
-/// they hold, and the bounding boxes of the objects cut by the plane (seed 004,
-/// figures 6–7).
+/// they hold, and the bounding boxes of the objects cut by the plane
+/// [sources: figures].
 pub fn octree_partition(spheres: &[Sphere], hint: &SceneHint) -> Result<Canvas, String> {
     let mut tree = indices::octree(hint).map_err(|e| e.to_string())?;
     for (i, s) in spheres.iter().enumerate() {

@@ -4,10 +4,10 @@
 //! proxima render TRACE [--out DIR] [--svg]
 //! proxima render --collide A B [--pose R00 … R22 TX TY TZ | --poses FILE] [--out DIR] [--svg]
 //! ```
-//! With a trace (design §4.1): the loose k-d tree's and the octree's partitions of
+//! With a trace [sources: trace-format]: the loose k-d tree's and the octree's partitions of
 //! the objects alive at the end of the trace, as `proxima demo` draws them. With
 //! `--collide`: the two meshes (the first one posed; a pose is 12 numbers, a
-//! row-major rotation then a translation, as in pose files, design §4.2; `--poses`
+//! row-major rotation then a translation, as in pose files [sources: pose-format]; `--poses`
 //! takes the first pose of a file), with the triangles that intersect in red.
 //! Exit codes: 0 success, 2 bad input (one line naming the file and line).
 

@@ -1,4 +1,4 @@
-//! `proxima replay TRACE [--index NAME|all] [--check] [--time]` (design §4, §4.1).
+//! `proxima replay TRACE [--index NAME|all] [--check] [--time]` [sources: cli, trace-format].
 //!
 //! Parses and checks the trace (see [`crate::trace`]), runs it through one index or
 //! several, prints one line per query, and with several indices compares every
@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 /// Options of `proxima replay`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The trace file (design §4.1 format).
+    /// The trace file (format: docs/sources.md#trace-format).
     pub trace: PathBuf,
     /// Index to run (`brute`, … or `all`: every index, each compared with brute).
     #[arg(long, default_value = BRUTE)]

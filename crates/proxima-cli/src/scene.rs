@@ -1,4 +1,4 @@
-//! Generated scenes for `proxima demo` (design §5, W1–W3).
+//! Generated scenes for `proxima demo` [sources: w1, w2, w3].
 //!
 //! `n` spheres with radii uniform in [0.5, 2]; each frame every sphere takes a
 //! small step along its own slowly-wandering velocity and bounces off the walls of
@@ -30,7 +30,7 @@ pub const CLUSTERS: usize = 8;
 /// Size of the `flat` world.
 pub const FLAT_WORLD: Vec3 = Vec3::new(1000.0, 1000.0, 10.0);
 
-/// Where the centres of a generated scene lie (design §5).
+/// Where the centres of a generated scene lie [sources: workloads].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SceneKind {
     /// W1: uniform in a cube.
@@ -42,7 +42,7 @@ pub enum SceneKind {
 }
 
 impl SceneKind {
-    /// Every kind, in the order of design §5.
+    /// Every kind, in the order of [sources: workloads].
     pub const ALL: [SceneKind; 3] = [SceneKind::Uniform, SceneKind::Flat, SceneKind::Clustered];
 
     /// The name used on the command line.

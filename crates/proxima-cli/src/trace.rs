@@ -1,4 +1,4 @@
-//! Parser of the scene-trace format of `proxima replay` (design §4.1).
+//! Parser of the scene-trace format of `proxima replay` [sources: trace-format].
 //!
 //! The whole trace is parsed and checked before any index runs: syntax, finite
 //! numbers, query shapes (through the library's own `validate`), and id liveness

@@ -1,4 +1,4 @@
-//! W5 mesh vs mesh (design §5): rob.obj vs env.obj at 1,000 random poses (FCL's
+//! W5 mesh vs mesh [sources: w5]: rob.obj vs env.obj at 1,000 random poses (FCL's
 //! distribution: translations in [-3000,3000]²×[0,3000], uniformly random
 //! rotations), all pairs and first contact, for every BV type; and SKINbody vs
 //! BONERibcage at a few poses. Criterion reports the time of the whole batch; the

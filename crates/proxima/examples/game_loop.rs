@@ -15,7 +15,7 @@ struct Body {
 
 fn main() -> proxima::Result<()> {
     let world = Aabb::new(Vec3::ZERO, Vec3::splat(100.0));
-    // Loose k-d tree: world box, largest radius, density (design §2.1).
+    // Loose k-d tree: world box, largest radius, density [sources: kd-tree].
     let mut index = LooseKdTree::<usize>::new(world, 1.0, 0.25)?;
 
     // Spawn 2000 bodies on a deterministic pseudo-random lattice.

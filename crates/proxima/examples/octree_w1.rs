@@ -1,4 +1,4 @@
-//! Rough timing of the linear octree on workload W1 (design §5): N spheres with
+//! Rough timing of the linear octree on workload W1 [sources: w1]: N spheres with
 //! radii in [0.5, 2] in a cube of side 4·N^(1/3), each moving a small random step
 //! per frame and bouncing off the walls; a frame = update all + find all pairs.
 //! Also compares the pair traversal with one sphere query per object.

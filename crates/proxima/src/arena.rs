@@ -1,7 +1,7 @@
 //! Index-based storage shared by every structure: a generational [`Arena`] for the
 //! user's objects (stable [`Handle`]s, O(1) insert/remove/lookup) and a plain
 //! [`Pool`] with a free list for tree nodes. Both are flat `Vec`s, as in Box2D's
-//! `b2DynamicTree`; this is the seed's "equal-size block allocator".
+//! `b2DynamicTree`; this is the "equal-size block allocator" of [sources: block-alloc].
 
 use crate::{Error, Result};
 use std::sync::atomic::{AtomicU32, Ordering};

@@ -5,8 +5,8 @@
 //! - [`geom`]: the primitive shapes (`Sphere`, `Aabb`, `Ray`, `Segment`, `Plane`,
 //!   `Frustum`) and the one implementation of every closed overlap test between them.
 //! - [`broad`]: the [`broad::SpatialIndex`] trait over bounding spheres and its
-//!   indices: [`broad::BruteForce`] (the oracle) and the loose k-d tree of the first
-//!   source document, with more to come.
+//!   indices: [`broad::BruteForce`] (the oracle) and the loose k-d tree
+//!   [sources: kd-tree], with more to come.
 //! - [`narrow`]: triangle meshes and the exact, closed triangle–triangle test.
 //! - [`io`]: OBJ, STL and PLY loaders into a [`narrow::TriMesh`].
 //!

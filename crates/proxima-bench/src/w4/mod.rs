@@ -1,6 +1,6 @@
 //! `proxima-bench w4 [--n N] [--queries Q] [--frusta F] [--reps R] [--threads K] [--seed S] [--clock cpu|wall] [--only A,B] [--order morton|input] [--json]`
 //!
-//! W4 (design §5): queries on a static set. W1's spheres (radii in `[0.5, 2]`,
+//! W4 [sources: w4]: queries on a static set. W1's spheres (radii in `[0.5, 2]`,
 //! centres uniform in a cube of side `4·N^(1/3)`) are loaded once into every
 //! structure (build timed; Proxima's indices are loaded by inserting in Morton
 //! order of the centres, `--order input` for the generated order), then each

@@ -1,4 +1,4 @@
-//! W4's query batches (design §5): deterministic from a seed, sized to the scene.
+//! W4's query batches [sources: w4]: deterministic from a seed, sized to the scene.
 //!
 //! Over W1's set (centres uniform in a cube of side `L = 4·N^(1/3)`, radii in
 //! `[0.5, 2]`, about one sphere per 64 unit³):

@@ -1,4 +1,4 @@
-//! W5 mesh vs mesh (design §5; seed 003): each mesh pair at many relative poses,
+//! W5 mesh vs mesh [sources: w5, bvh]: each mesh pair at many relative poses,
 //! through every bounding-volume type with SAH trees, and parry3d's `TriMesh` as
 //! the peer.
 //!

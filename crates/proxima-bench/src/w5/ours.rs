@@ -1,5 +1,5 @@
 //! W5 for Proxima: one bounding-volume type, SAH trees, all-pairs and
-//! first-contact queries timed one by one, with the seed's cost counters.
+//! first-contact queries timed one by one, with the cost counters of [sources: bvh-cost].
 
 use crate::run::Clock;
 use proxima::glam::Affine3A;

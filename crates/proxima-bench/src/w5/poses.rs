@@ -6,7 +6,7 @@ use proxima::narrow::TriMesh;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-/// Parses a pose file (design §4.2): 12 numbers per line, a row-major rotation
+/// Parses a pose file [sources: pose-format]: 12 numbers per line, a row-major rotation
 /// then a translation; `#` comments and blank lines skipped. Errors name the line.
 pub fn parse(name: &str, text: &str) -> Result<Vec<Affine3A>, String> {
     let mut poses = Vec::new();

@@ -1,4 +1,4 @@
-//! W6, rays vs one mesh (design §5): `proxima-bench w6 [--mesh NAME,NAME]
+//! W6, rays vs one mesh [sources: w6]: `proxima-bench w6 [--mesh NAME,NAME]
 //! [--rays R] [--threads 1,2] [--repeats N] [--leaf L] [--seed S] [--only A,B]
 //! [--clock cpu|wall] [--json]`.
 //!

@@ -3,11 +3,11 @@
 //! | index | idea | source |
 //! |---|---|---|
 //! | [`BruteForce`] | scan everything; the oracle | — |
-//! | [`LinearOctree`] | sparse octree named by location codes in a hash map; O(1) face-neighbour codes, moves via neighbours, split/merge with hysteresis, loose bounds by max extent | seed 004 |
-//! | [`LooseKdTree`] | binary tree with overlapping children (shared border zone); each sphere in exactly one node | seed 000 (`SPHERE_SET_TREE`) |
-//! | [`HashGrid`] | unbounded 3D hashed grid; huge objects in an oversized list | seed 000 (3D) |
-//! | [`UniformGrid3d`] | dense uniform 3D grid over a world box; each object once, in its centre's cell; half-shell pair search; large objects in a list | seed 000 (3D) |
-//! | [`UniformGrid2d`] | uniform grid on the XY plane for flat worlds; objects referenced from every covered cell | seed 000 |
+//! | [`LinearOctree`] | sparse octree named by location codes in a hash map; O(1) face-neighbour codes, moves via neighbours, split/merge with hysteresis, loose bounds by max extent | [sources: octree] |
+//! | [`LooseKdTree`] | binary tree with overlapping children (shared border zone); each sphere in exactly one node | [sources: kd-tree] (`SPHERE_SET_TREE`) |
+//! | [`HashGrid`] | unbounded 3D hashed grid; huge objects in an oversized list | [sources: hash-grid] |
+//! | [`UniformGrid3d`] | dense uniform 3D grid over a world box; each object once, in its centre's cell; half-shell pair search; large objects in a list | [sources: grid3d] |
+//! | [`UniformGrid2d`] | uniform grid on the XY plane for flat worlds; objects referenced from every covered cell | [sources: grid2d] |
 //!
 //! Every index stores a [`Sphere`] and a user payload `T` per object and returns a
 //! generational [`Handle`]. Queries take `&self` (indices are `Send + Sync`, so
@@ -52,7 +52,7 @@ pub struct RayHit {
     pub t: f32,
 }
 
-/// The interface every broad-phase index implements (design §2).
+/// The interface every broad-phase index implements [sources: index-trait].
 ///
 /// Mutations validate their input and leave the index unchanged on error. Queries
 /// come in three forms: the generic [`SpatialIndex::query`] with any [`Selection`],

@@ -1,4 +1,4 @@
-//! Parallel pair finding and batch queries (design §6), behind the `parallel`
+//! Parallel pair finding and batch queries [sources: parallel], behind the `parallel`
 //! feature. Work runs on rayon's current pool: the global one, or whatever pool the
 //! caller `install`s (the benchmarks compare 1 and 2 threads that way).
 //!

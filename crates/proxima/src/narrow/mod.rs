@@ -1,5 +1,5 @@
 //! Narrow phase: triangle meshes, bounding-volume hierarchies over them, and
-//! mesh-vs-mesh collision down to exact triangle–triangle tests (seed 003).
+//! mesh-vs-mesh collision down to exact triangle–triangle tests [sources: bvh, tri-tri].
 
 pub mod bv;
 mod bvh;

@@ -51,7 +51,7 @@ fn sign(x: f64) -> i8 {
 /// are coplanar (or `a, b, c` are collinear). Swapping two arguments negates it.
 ///
 /// Inlined filter first: the determinant of the rounded `f64` differences as a
-/// cofactor expansion, certified when it exceeds [`O3D_ERRBOUND`] times its
+/// cofactor expansion, certified when it exceeds `O3D_ERRBOUND` times its
 /// permanent (Shewchuk's stage A); otherwise the `robust` crate's adaptive exact
 /// evaluation decides.
 #[inline]

@@ -1,5 +1,5 @@
 //! Exact, closed triangle–triangle intersection (the narrow-phase primitive test of
-//! seed 003): Guigue–Devillers' orientation-only algorithm, with every sign from the
+//! [sources: tri-tri]): Guigue–Devillers' orientation-only algorithm, with every sign from the
 //! exact predicates of [`predicates`](super::predicates), and explicit coplanar and
 //! degenerate branches.
 

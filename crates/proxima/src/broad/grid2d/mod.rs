@@ -1,4 +1,4 @@
-//! The uniform 2D grid of the first source document: for flat worlds (`dz << dx,
+//! The uniform 2D grid [sources: grid2d]: for flat worlds (`dz << dx,
 //! dy`) with objects of similar size, project every sphere onto the XY plane and
 //! reference it from every cell its footprint covers; a query visits the cells its
 //! own footprint covers.
@@ -33,7 +33,7 @@ struct Item<T> {
     value: T,
 }
 
-/// A uniform grid of square cells over a rectangle of the XY plane (seed 000: "2D
+/// A uniform grid of square cells over a rectangle of the XY plane ([sources: grid2d]: "2D
 /// grid on the XY plane" for worlds with `dz << dx, dy`).
 ///
 /// Every object is referenced from each cell its XY footprint (the bounding square
@@ -50,8 +50,8 @@ struct Item<T> {
 /// only speed suffers if many objects sit far outside (they crowd the border
 /// cells).
 ///
-/// **Once-only reporting with `&self`.** The seed marks each visited object with
-/// the current frame number so that an object seen in several cells is tested
+/// **Once-only reporting with `&self`.** The source marks each visited object with
+/// the current frame number [sources: grid-dedup] so that an object seen in several cells is tested
 /// once; that needs mutation during a query. Instead, a query whose cells form a
 /// rectangle reports an object only from the *lowest* cell of the overlap between
 /// the object's cell range and the query's, i.e. the cell `(max(ox0, qx0),

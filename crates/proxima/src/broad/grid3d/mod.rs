@@ -1,6 +1,6 @@
 //! A dense uniform 3D grid over a world box, for scenes of similar-sized objects
-//! spread evenly through a known volume (design §5, W1): the 3D counterpart of the
-//! first source document's grid, specialised for moving spheres.
+//! spread evenly through a known volume [sources: w1]: the 3D counterpart of the
+//! 2D grid [sources: grid2d, grid3d], specialised for moving spheres.
 //!
 //! Split by concern: [`cells`] (geometry and cell storage), `query` (range,
 //! frustum and ray visits), `pairs` (half-shell pair search), `par_pairs`

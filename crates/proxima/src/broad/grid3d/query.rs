@@ -53,7 +53,7 @@ impl<T> UniformGrid3d<T> {
     /// `Intersecting` splits the block in two along its longest axis, passing
     /// down the planes that still cut it (plane masking, as in a BVH), until
     /// blocks of [`LEAF_CELLS`] are scanned cell by cell. This is the frustum
-    /// culling of a hierarchy (design §5, W4) over the dense grid, with no
+    /// culling of a hierarchy [sources: w4] over the dense grid, with no
     /// stored tree: cost O(blocks near the query's boundary + cells inside it).
     fn visit_block<Q: Selection + ?Sized>(
         &self,

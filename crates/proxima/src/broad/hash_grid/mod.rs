@@ -1,6 +1,6 @@
 //! An unbounded 3D hashed grid: cells keyed by integer coordinates in a hash map,
-//! created when first occupied and dropped when emptied (design §2.3, the 3D
-//! counterpart of the first source document's 2D grid).
+//! created when first occupied and dropped when emptied ([sources: hash-grid], the 3D
+//! counterpart of the 2D grid of [sources: grid2d]).
 //!
 //! Split by concern: [`keys`] (cell coordinates), `link` (cells, references, the
 //! oversized list), `query` (range and frustum queries), `ray`, `pairs`,

@@ -1,4 +1,4 @@
-//! Insertion (seed `RecursivePush`, iterative): the placement rule, lazy node
+//! Insertion ([sources: kd-insert]: `RecursivePush`, iterative): the placement rule, lazy node
 //! creation, and the O(1) placement and swap-removal of objects in a node's range
 //! of the object array (`store.rs`), including the compaction of that array.
 
@@ -102,7 +102,7 @@ impl<T> LooseKdTree<T> {
             .expect("placing a live item") = Loc { node, pos: len };
     }
 
-    /// Takes the object at `loc` out of its node (seed `DeleteItem`) by moving the
+    /// Takes the object at `loc` out of its node ([sources: kd-remove]: `DeleteItem`) by moving the
     /// node's last object into the hole, whose location is updated. O(1). The
     /// taken object's own location is stale until it is placed again.
     pub(super) fn take(&mut self, loc: Loc) -> (Sphere, Handle, T) {

@@ -1,6 +1,5 @@
-//! The loose k-d tree over bounding spheres of the first source document (the C++
-//! class `SPHERE_SET_TREE`: `Push`, `Pop`, `Move`, `Clear`, `TestIntersection`),
-//! design §2.1.
+//! The loose k-d tree over bounding spheres [sources: kd-tree] (the source's C++
+//! class `SPHERE_SET_TREE`: `Push`, `Pop`, `Move`, `Clear`, `TestIntersection`).
 //!
 //! Files, one concern each: `node.rs` (node layout, box derivation, conservative
 //! regions, the per-node object vectors), `insert.rs` (the placement rule, node
@@ -37,7 +36,7 @@ use std::ops::ControlFlow;
 use store::Store;
 
 /// A good density for scenes of many similar spheres moving a little per frame
-/// (design §5, W1): measured with the W1 frame (update all + all pairs). With the
+/// [sources: w1]: measured with the W1 frame (update all + all pairs). With the
 /// objects in one depth-first array (`store.rs`), 0.15 beat 0.2 at N = 100k
 /// (frame ~5–10% faster, 138 instead of 200 bytes per object, build twice as
 /// fast) and at 10k (~5–10%); 0.12 and 0.1 were 20–40% slower at 100k, 0.3 and
@@ -66,11 +65,11 @@ struct Loc {
     pos: u32,
 }
 
-/// The loose k-d tree of seed 000: a binary, unbalanced tree built lazily over a
+/// The loose k-d tree of [sources: kd-tree]: a binary, unbalanced tree built lazily over a
 /// world box, whose two children overlap in a shared border zone so that every
 /// sphere lives in exactly one node (never duplicated, never split).
 ///
-/// # Structure (design §2.1)
+/// # Structure [sources: kd-border, kd-insert, kd-move]
 ///
 /// A node covers a box `B` and splits its longest axis `a` at the centre `m`, with
 /// border half-width `h = min(R_max, extent_a(B) · d / 4)` (`d` = density). The
@@ -85,15 +84,15 @@ struct Loc {
 ///
 /// **Placement invariant.** At every moment, each sphere sits exactly in the node
 /// where inserting it afresh would put it (the tree is a function of the current
-/// set of spheres, not of their history). The seed's `Move` keeps a moved sphere in
+/// set of spheres, not of their history). The source's `Move` keeps a moved sphere in
 /// its node while it stays inside the node's box `B`; this implementation instead
 /// keeps it while the *placement rule* still routes it there (its centre is on the
 /// same side of every ancestor's centre plane, `r` is still below every ancestor's
 /// `h` and still `>= h` here). For a sphere inside the world this implies the
-/// seed's condition (a routed sphere lies inside `B`), so only the bookkeeping is
+/// source's condition (a routed sphere lies inside `B`), so only the bookkeeping is
 /// stricter: pruning, [`LooseKdTree::validate`] and the oracle tests all rely on
 /// one exact invariant, and spheres outside the world box move as cheaply as
-/// inside ones (the seed's box test fails for them at every node, even the root).
+/// inside ones (the source's box test fails for them at every node, even the root).
 ///
 /// # Costs
 ///
@@ -233,7 +232,7 @@ impl<T> LooseKdTree<T> {
 }
 
 impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
-    /// Seed `Push`: O(depth), creating the missing nodes on the way.
+    /// `Push` [sources: kd-insert]: O(depth), creating the missing nodes on the way.
     fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
         sphere.validate()?;
         // Before `cover` and `descend` change the tree: a full index stays as it was.
@@ -247,7 +246,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         Ok(handle)
     }
 
-    /// Seed `Pop`: O(1) swap-remove from the node, then frees emptied nodes upwards.
+    /// `Pop` [sources: kd-remove]: O(1) swap-remove from the node, then frees emptied nodes upwards.
     fn remove(&mut self, handle: Handle) -> Result<T> {
         let loc = *self.items.get(handle)?;
         let (_, _, value) = self.take(loc);
@@ -258,7 +257,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         Ok(value)
     }
 
-    /// Seed `Move`; see the type's docs for when the object changes node.
+    /// `Move` [sources: kd-move]; see the type's docs for when the object changes node.
     fn update(&mut self, handle: Handle, sphere: Sphere) -> Result<()> {
         sphere.validate()?;
         let loc = *self.items.get(handle)?;
@@ -284,7 +283,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.items.len()
     }
 
-    /// Seed `Clear`: drops every node and object and releases the memory.
+    /// `Clear` [sources: kd-tree]: drops every node and object and releases the memory.
     fn clear(&mut self) {
         self.items.clear();
         self.nodes.clear();

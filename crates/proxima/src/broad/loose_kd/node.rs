@@ -8,7 +8,7 @@ use glam::Vec3;
 /// "No node / no item".
 pub(super) const NIL: u32 = u32::MAX;
 
-/// A tree node (seed `NODE`), flat in a [`Pool`](crate::arena::Pool).
+/// A tree node (the source's `NODE`, [sources: kd-tree]), flat in a [`Pool`](crate::arena::Pool).
 ///
 /// Laid out by hand (`repr(C)`, one cache line per node start): the fields the
 /// pair walk reads at every node (objects, children, split) and those a move
@@ -29,7 +29,7 @@ pub(super) struct Node {
     pub m: f32,
     /// Border half-width `min(R_max, extent_axis(bbox) · d / 4)`.
     pub h: f32,
-    /// Split axis: the longest of `bbox` (ties to the lower index, as in the seed).
+    /// Split axis: the longest of `bbox` (ties to the lower index, [sources: kd-insert]).
     pub axis: u8,
     pub depth: u8,
     /// Set by a move that kept its node without growing its chunk bound: the
@@ -47,7 +47,7 @@ pub(super) struct Node {
     /// In the first cache line, with `h_up`, `h`, `depth` and `start`: a move
     /// that keeps its node reads only that line.
     pub cell: Aabb,
-    /// The seed's box `B`: the world box, narrowed by one face per split above.
+    /// The box `B` of [sources: kd-border]: the world box, narrowed by one face per split above.
     pub bbox: Aabb,
 }
 
@@ -82,8 +82,8 @@ impl Node {
         }
     }
 
-    /// Box and cell of the child on `side` (0 negative, 1 positive): the seed's
-    /// `B2.Max[a] -= UnusedSpace` / `B2.Min[a] += UnusedSpace`, written as
+    /// Box and cell of the child on `side` (0 negative, 1 positive): the source's
+    /// `B2.Max[a] -= UnusedSpace` / `B2.Min[a] += UnusedSpace` [sources: kd-border], written as
     /// `m + h` / `m - h` directly.
     pub fn child_bounds(&self, side: usize) -> (Aabb, Aabb) {
         let a = self.axis as usize;
@@ -122,7 +122,7 @@ impl Node {
     }
 }
 
-/// Split axis, centre and border half-width of a node box (seed `RecursivePush`,
+/// Split axis, centre and border half-width of a node box ([sources: kd-insert]: `RecursivePush`,
 /// steps 1 and 3). `m` is computed as `min/2 + max/2` so huge boxes do not overflow.
 pub(super) fn split_of(b: &Aabb, r_max: f32, density: f32) -> (u8, f32, f32) {
     let axis = b.longest_axis();

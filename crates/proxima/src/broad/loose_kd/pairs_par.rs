@@ -1,4 +1,4 @@
-//! Parallel pair finding (design §6): the node-vs-node walk of `pairs.rs` split
+//! Parallel pair finding [sources: parallel]: the node-vs-node walk of `pairs.rs` split
 //! into independent rayon tasks near the top of the tree.
 //!
 //! At a node, once its own objects are tested (against each other and the active

@@ -1,4 +1,4 @@
-//! Queries (seed `TestIntersection`, generalized to any [`Selection`]) and the
+//! Queries ([sources: kd-query]: `TestIntersection`, generalized to any [`Selection`]) and the
 //! front-to-back first-hit ray search.
 
 use super::node::{FixedStack, NIL};
@@ -40,7 +40,7 @@ impl<T> LooseKdTree<T> {
     /// Per child, two conservative filters, both decided from the *parent* (already
     /// in cache), so a pruned child's node is never loaded — on a large tree each
     /// node load is a cache miss, and it is what the profile of W4's queries shows:
-    /// 1. the seed's one comparison on the split axis against `query.bounds()`
+    /// 1. the source's one comparison [sources: kd-query] on the split axis against `query.bounds()`
     ///    (descend positive only if `q_max_a >= m - h`, negative only if
     ///    `q_min_a <= m + h`, each with slack): every sphere of the positive subtree
     ///    has `c_a - r > m - h`, so a query box ending before `m - h` selects none

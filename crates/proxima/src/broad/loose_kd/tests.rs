@@ -11,8 +11,8 @@ fn cube(side: f32) -> Aabb {
     Aabb::new(Vec3::ZERO, Vec3::splat(side))
 }
 
-/// The seed's `RecursivePush`, re-derived on boxes alone (independently of the
-/// tree's code): the depth and box where a sphere must sit.
+/// The source's `RecursivePush` [sources: kd-insert], re-derived on boxes alone
+/// (independently of the tree's code): the depth and box where a sphere must sit.
 fn seed_placement(world: Aabb, r_max: f32, d: f32, cap: usize, s: &Sphere) -> (usize, Aabb) {
     let mut b = world;
     let mut depth = 0;
@@ -106,7 +106,7 @@ fn crafted_spheres_land_where_the_seed_puts_them() {
 }
 
 /// Random inserts, moves (small, long, resizes, out of the world) and removals:
-/// after every step each object sits exactly where the seed's rule puts it.
+/// after every step each object sits exactly where the rule of [sources: kd-insert] puts it.
 #[test]
 fn placement_invariant_over_random_history() {
     for (d, cap) in [(0.5, 40u8), (0.1, 40), (1.0, 6)] {

@@ -1,4 +1,4 @@
-//! Removal of emptied nodes (seed `DeleteNode`) and moves (seed `Move`).
+//! Removal of emptied nodes (`DeleteNode`) and moves (`Move`) [sources: kd-remove, kd-move].
 
 use super::node::NIL;
 use super::{Loc, LooseKdTree};
@@ -24,7 +24,7 @@ impl<T> LooseKdTree<T> {
         Some(p)
     }
 
-    /// Frees `n` and then each ancestor while they are empty (seed `Pop` loop).
+    /// Frees `n` and then each ancestor while they are empty ([sources: kd-remove]: the `Pop` loop).
     pub(super) fn prune_up(&mut self, mut n: u32) {
         while n != NIL {
             match self.free_if_empty(n) {

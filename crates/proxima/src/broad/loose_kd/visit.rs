@@ -34,7 +34,7 @@ impl<T> LooseKdTree<T> {
     /// Calls `f` for every live node, parents before their children (depth-first,
     /// negative child first). O(nodes); allocates one stack of at most the depth.
     ///
-    /// This is how the seed's figures of the tree (node boxes and their shared
+    /// This is how the figures of the tree [sources: figures] (node boxes and their shared
     /// border zones) can be drawn; it changes nothing.
     pub fn for_each_node(&self, mut f: impl FnMut(&KdNodeView)) {
         if self.root == NIL {

@@ -1,18 +1,18 @@
-//! Location codes: the names of octree cells (seed 004, §2; design §2.2).
+//! Location codes: the names of octree cells [sources: octree-code].
 //!
 //! A code is a `u64` holding a leading sentinel 1 bit followed by 3 bits per level,
 //! from the root down: bit 0 of each triple is the x half (0 = low, 1 = high), bit 1
 //! the y half, bit 2 the z half. It is a Morton (Z-order) code that also encodes its
 //! depth: the sentinel sits at bit `3 * depth`. The root is `1`; depth 21 uses all
-//! 64 bits. The seed writes the same thing as octal digits `q1 q2 … qn`.
+//! 64 bits. The source writes the same thing as octal digits `q1 q2 … qn`.
 //!
 //! Because the x bits of all levels sit at positions `0, 3, 6, …` ("dilated"
 //! integers), adding or subtracting one cell along an axis is one integer addition
 //! with masks: fill the other axes' bits with ones so the carry jumps over them
 //! (`+1`), or let the borrow run through them and mask it away (`-1`). That is the
-//! seed's octal rule ("add 4 to the trailing digits of the upper set, subtract 4
+//! source's octal rule ("add 4 to the trailing digits of the upper set, subtract 4
 //! from the first one that is not") done for all levels at once, in O(1), with no
-//! loop over the levels.
+//! loop over the levels [sources: octree-neighbour].
 
 use crate::geom::Aabb;
 use glam::Vec3;
@@ -244,7 +244,7 @@ impl LocationCode {
     /// `(a | !mask) + 1` (ones in the other axes' bits carry the increment across
     /// them) or decremented by `a - 1` (the borrow through the other axes' bits is
     /// masked off). The world border is where the coordinate is all ones (+) or all
-    /// zeros (−) — the seed's "every digit in the E/W/… set" test.
+    /// zeros (−) — the source's "every digit in the E/W/… set" test [sources: octree-neighbour].
     #[inline]
     pub fn face_neighbor(self, face: Face) -> Option<LocationCode> {
         let d = self.depth();

@@ -1,5 +1,5 @@
 //! Insertion and removal, with the split of full leaves and the merge of thinned
-//! subtrees (seed 004 §3.1 and §3.2.2, last paragraphs).
+//! subtrees [sources: octree-split, octree-merge].
 
 use super::code::MAX_DEPTH;
 use super::node::{Item, Obj, NONE};
@@ -129,7 +129,7 @@ impl<T> LinearOctree<T> {
     }
 
     /// Turns inner node `x` back into a leaf holding every object of its subtree
-    /// (the seed's merge of a parent that no longer meets the split criterion).
+    /// (the source's merge of a parent that no longer meets the split criterion).
     pub(super) fn collapse(&mut self, x: u32) {
         self.counters.merges += 1;
         let mut items = self.spare.pop().unwrap_or_default();

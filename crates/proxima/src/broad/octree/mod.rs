@@ -1,4 +1,4 @@
-//! The linear octree of the third source document (seed 004; design §2.2).
+//! The linear octree for dynamic scenes [sources: octree, octree-code].
 //!
 //! Cells are named by [`LocationCode`]s and found through a hash map from code to
 //! node, so moving an object to the next cell is "compute the neighbour's code,
@@ -78,13 +78,13 @@ impl OctreeConfig {
     }
 }
 
-/// A sparse linear octree over bounding spheres (seed 004; design §2.2).
+/// A sparse linear octree over bounding spheres [sources: octree, octree-code].
 ///
 /// **Structure.** The root cell is the cube centred on the world box whose side is
-/// the box's longest extent (the seed's cells are cubes; a flat world thus gets
+/// the box's longest extent (the source's cells are cubes; a flat world thus gets
 /// cubic cells, not slabs). Every node is named by its [`LocationCode`]; a
 /// [`FxHashMap`] from code to node index replaces pointers for random access (the
-/// seed's MAP), and nodes live in a [`Pool`] with a free list. Inner nodes also keep
+/// source's MAP), and nodes live in a [`Pool`] with a free list. Inner nodes also keep
 /// the indices of their children for top-down traversals. The tree is sparse: a
 /// split creates only the octants that receive objects, and an object moving into
 /// empty space creates the one leaf it needs. Emptied leaves are deleted.
@@ -107,7 +107,7 @@ impl OctreeConfig {
 /// lookup; a centre that moves to an adjacent cell (across a face, edge or corner)
 /// goes through [`LocationCode::face_neighbor`] and a map lookup, then resolves a
 /// neighbour at another depth by going up (larger leaf) or down toward the centre
-/// (smaller leaves), as in the seed §3.2.2; a long jump finds the leaf from the code
+/// (smaller leaves), as in [sources: octree-depths]; a long jump finds the leaf from the code
 /// of the new centre by a binary search over depths (≈ log2(depth) map lookups).
 /// The three paths are counted in [`LinearOctree::stats`].
 ///

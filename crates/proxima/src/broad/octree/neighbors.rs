@@ -1,4 +1,4 @@
-//! Face neighbours across depths (seed 004 §3.2.2): the same-depth neighbour code
+//! Face neighbours across depths [sources: octree-depths]: the same-depth neighbour code
 //! is computed arithmetically; if the map does not hold it, the neighbour is a
 //! larger leaf (go up) or empty space, and if it is an inner node, the neighbours
 //! are its smaller leaves touching the shared face (go down).

@@ -1,5 +1,5 @@
 //! Queries: one top-down traversal for every [`Selection`], with loose boxes
-//! (seed 004 §3.2.3: classify cells against the frustum as outside / inside /
+//! ([sources: octree-cull]: classify cells against the frustum as outside / inside /
 //! intersecting).
 
 use super::node::NONE;

@@ -168,7 +168,7 @@ fn face_neighbors_across_depths_match_brute_force() {
     }
 }
 
-/// The seed's experiment (§4): 12 objects moving freely through an octree split
+/// The experiment of [sources: octree-experiment]: 12 objects moving freely through an octree split
 /// down to one object per leaf, validated after every frame. Every move is
 /// classified independently by geometry (where the new centre lies relative to
 /// the old leaf's box) and the stats must show the matching path.

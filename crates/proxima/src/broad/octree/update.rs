@@ -1,4 +1,4 @@
-//! Moves (seed 004 §3.2): an object whose centre leaves its leaf goes to the
+//! Moves [sources: octree-move, octree-depths]: an object whose centre leaves its leaf goes to the
 //! neighbouring leaf found through the face-neighbour code and the map, also when
 //! that neighbour sits at another depth; a long jump finds its leaf from the code
 //! of the new centre.
@@ -66,12 +66,12 @@ impl<T> LinearOctree<T> {
     }
 
     /// The leaf containing `key` given `n`, a same-depth neighbour cell of the
-    /// object's old leaf that contains `key` (seed §3.2.2): if `n` is a node, go
+    /// object's old leaf that contains `key` [sources: octree-depths]: if `n` is a node, go
     /// down toward the centre (smaller neighbours); if not, go up to the first
     /// existing ancestor (a larger neighbour, or an inner node whose octant toward
     /// the centre is empty space and gets a new leaf).
     ///
-    /// The seed guesses whether to search up or down first from the node's depth
+    /// The source guesses whether to search up or down first from the node's depth
     /// relative to the tree's depth; here one map lookup of `n` decides it (a node:
     /// same depth or down; absent: up), so no guess is needed.
     pub(super) fn resolve_neighbor(&mut self, n: LocationCode, key: u64) -> u32 {

@@ -4,7 +4,7 @@ use super::{clip_slab, BoundingVolume};
 use crate::geom::{Aabb, Ray};
 use glam::{Affine3A, Vec3};
 
-/// The AABB is the 6-DOP of the seed: three coordinate slabs, 6 comparisons per test.
+/// The AABB is the 6-DOP of [sources: kdop]: three coordinate slabs, 6 comparisons per test.
 impl BoundingVolume for Aabb {
     /// `(lo, hi)`: the translation minus/plus the slack, added to `min`/`max`.
     type Motion = (Vec3, Vec3);

@@ -1,4 +1,4 @@
-//! k-DOPs (discrete orientation polytopes) with K = 14, 18, 26 (seed 003).
+//! k-DOPs (discrete orientation polytopes) with K = 14, 18, 26 [sources: kdop].
 
 use super::{clip_slab, BoundingVolume};
 use crate::geom::Ray;
@@ -6,7 +6,7 @@ use crate::{Error, Result};
 use glam::{Affine3A, Vec3};
 
 /// A k-DOP: the intersection of `K/2` slabs `min_i <= dot(axis_i, p) <= max_i` with
-/// fixed integer axes, as in the seed (Klosowski et al.):
+/// fixed integer axes, as in the source (Klosowski et al.) [sources: kdop]:
 /// - `K = 14`: the 3 coordinate axes and the 4 corner diagonals `(1,1,1)`,
 ///   `(1,-1,1)`, `(1,1,-1)`, `(1,-1,-1)` (cut the 8 corners of the AABB);
 /// - `K = 18`: the 3 coordinate axes and the 6 edge diagonals `(1,1,0)`, `(1,0,1)`,
@@ -264,7 +264,7 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
 
     #[inline]
     fn overlaps(&self, m: &Self::Motion, o: &Self) -> bool {
-        // Branch-free: K comparisons, as the seed counts them.
+        // Branch-free: K comparisons, as [sources: kdop] counts them.
         let mut sep = false;
         for i in 0..Self::H {
             sep |= self.d[i] + m.d[i] > o.d[i + Self::H];

@@ -1,6 +1,6 @@
-//! Bounding volumes for mesh BVHs, behind one trait (seed 003).
+//! Bounding volumes for mesh BVHs, behind one trait [sources: bv-kinds, bvh-cost].
 //!
-//! The seed compares spheres, AABBs, OBBs and k-DOPs through the cost model
+//! The source compares spheres, AABBs, OBBs and k-DOPs through the cost model
 //! `T = Nv*Cv + Np*Cp + Nu*Cu`: a tighter volume lowers `Nv` (volume tests) and `Np`
 //! (triangle tests), a cheaper one lowers `Cv`, and one that is cheap to update under
 //! motion lowers `Nu*Cu`. Every volume here implements [`BoundingVolume`], so a
@@ -45,7 +45,7 @@ pub trait BoundingVolume: Copy + Debug + Send + Sync + 'static {
 
     /// True for volumes whose slab normals are fixed in the world (AABB, k-DOPs):
     /// [`BoundingVolume::motion`] then reads only the translation of the pose, and a
-    /// rotated pose is handled by refitting the moving tree (seed 003) or by
+    /// rotated pose is handled by refitting the moving tree [sources: bvh-rotate] or by
     /// [`BoundingVolume::transformed`].
     const AXIS_ALIGNED: bool;
 
@@ -76,7 +76,8 @@ pub trait BoundingVolume: Copy + Debug + Send + Sync + 'static {
 
     /// A volume containing this one moved by `pose` (a rigid motion). Exact for
     /// [`Obb`] and spheres; for axis-aligned volumes a conservative bound (the
-    /// k-DOP of the rotated AABB part), the seed's refit being the exact alternative.
+    /// k-DOP of the rotated AABB part), the source's refit being the exact alternative
+    /// [sources: bvh-rotate].
     fn transformed(&self, pose: &Affine3A) -> Self;
 
     /// Prepares `pose` (moving frame → other frame) and the rounding `slack`.

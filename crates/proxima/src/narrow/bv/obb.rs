@@ -1,4 +1,4 @@
-//! Oriented bounding boxes (Gottschalk, Lin, Manocha: "OBBTree", cited by seed 003).
+//! Oriented bounding boxes (Gottschalk, Lin, Manocha: "OBBTree"; [sources: bv-kinds]).
 
 // Index loops read like the matrix formulas they implement.
 #![allow(clippy::needless_range_loop)]
@@ -11,7 +11,7 @@ use glam::{Affine3A, Mat3, Mat3A, Vec3, Vec3A};
 /// (columns). Fitted by principal component analysis (the triangle-area covariance of
 /// OBBTree, or the point covariance), falling back to the world axes when the AABB is
 /// smaller. Overlap is the 15-axis separating-axis test under the relative pose, so a
-/// rotation costs nothing but the test itself (seed 003: OBBs trade a costlier `Cv`
+/// rotation costs nothing but the test itself ([sources: bvh-cost]: OBBs trade a costlier `Cv`
 /// for a tight fit and free updates).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Obb {

@@ -5,7 +5,7 @@ use crate::geom::{Ray, Sphere};
 use glam::{Affine3A, Vec3, Vec3A};
 
 /// Bounding spheres: the cheapest test (one distance) and free under rotation, but
-/// the loosest fit (seed 003, Fig. 1b). Fitted around the centre of the points' AABB.
+/// the loosest fit [sources: bv-kinds]. Fitted around the centre of the points' AABB.
 impl BoundingVolume for Sphere {
     /// The pose and the slack.
     type Motion = (Affine3A, f32);

@@ -1,4 +1,4 @@
-//! Top-down binary build (seed 003).
+//! Top-down binary build [sources: bvh-build].
 
 use super::tree::{coord_bound, Bvh, Node};
 use crate::geom::Aabb;
@@ -9,9 +9,9 @@ use glam::Vec3;
 
 /// How a node's triangles are split in two.
 ///
-/// The seed splits "by a plane orthogonal to one of the three coordinate axes through
-/// the mean or the median of the centroid coordinates"; the axis here is the one
-/// along which the centroids spread most.
+/// The source [sources: bvh-build] splits "by a plane orthogonal to one of the three
+/// coordinate axes through the mean or the median of the centroid coordinates"; the
+/// axis here is the one along which the centroids spread most.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SplitRule {
     /// Plane through the mean centroid coordinate (falls back to the median when one
@@ -20,7 +20,7 @@ pub enum SplitRule {
     /// Plane through the median: a balanced tree of depth `⌈log2(n / leaf)⌉ + 1`.
     Median,
     /// Binned surface-area heuristic (16 bins on each axis, AABB areas): the plane
-    /// minimizing `area(L)·|L| + area(R)·|R|`. Not in the seed; the default, since
+    /// minimizing `area(L)·|L| + area(R)·|R|`. Not in [sources: bvh-build]; the default, since
     /// its trees need 35–45 % fewer volume tests than the median's on W5.
     #[default]
     Sah,

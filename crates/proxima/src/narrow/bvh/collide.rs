@@ -1,5 +1,5 @@
 //! Collision of two posed meshes: simultaneous traversal of their BVHs down to exact
-//! triangle–triangle tests, with the seed's cost counters.
+//! triangle–triangle tests, with the cost counters of [sources: bvh-cost].
 
 use super::traverse::{traverse, Lazy, Local, Precomputed};
 use super::tree::Bvh;
@@ -27,8 +27,8 @@ pub enum RotationUpdate {
     /// teapot and hand-vs-forearm, ~2,000-node trees: ~1 µs vs 47 µs median).
     #[default]
     Auto,
-    /// The seed's method: transform the moving mesh's vertices and recompute every
-    /// node's volume bottom-up (exact; `Nu` = number of nodes).
+    /// The source's method [sources: bvh-rotate]: transform the moving mesh's
+    /// vertices and recompute every node's volume bottom-up (exact; `Nu` = number of nodes).
     Refit,
     /// Bound each visited node's rotated volume from its own AABB part
     /// ([`BoundingVolume::transformed`]), lazily: looser volumes, but only the nodes
@@ -36,7 +36,7 @@ pub enum RotationUpdate {
     Conservative,
 }
 
-/// The seed's cost counters: `T = Nv*Cv + Np*Cp + Nu*Cu`.
+/// The cost counters of [sources: bvh-cost]: `T = Nv*Cv + Np*Cp + Nu*Cu`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct CostCounters {
     /// Bounding-volume pair tests (`Nv`).

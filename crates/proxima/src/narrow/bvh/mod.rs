@@ -1,11 +1,12 @@
-//! Bounding-volume hierarchies over triangle meshes (seed 003).
+//! Bounding-volume hierarchies over triangle meshes [sources: bvh].
 //!
 //! - [`tree`](Bvh): the flat node array and its accessors;
 //! - `build.rs`: top-down binary build, split at the mean or the median of the
-//!   triangle centroids (the seed's two rules) or by a binned surface-area heuristic;
+//!   triangle centroids (the source's two rules, [sources: bvh-build]) or by a
+//!   binned surface-area heuristic;
 //! - `refit.rs`: bottom-up refit for deformed vertices, and the exact world-frame
-//!   refit of a rotated tree (the seed's rotation update);
-//! - `traverse.rs`: the simultaneous descent of two trees (seed 003, Fig. 2);
+//!   refit of a rotated tree (the source's rotation update, [sources: bvh-rotate]);
+//! - `traverse.rs`: the simultaneous descent of two trees [sources: bvh-traverse];
 //! - `collide.rs`: mesh–mesh collision of two posed meshes with the cost counters;
 //! - `tri_cache.rs`: the per-query cache of prepared triangles;
 //! - `ray.rs`: ray and segment casts; `ray_tree.rs` + `ray_cast.rs`: [`RayBvh`], the

@@ -1,4 +1,4 @@
-//! Parallel batch ray casts (design §6): one ray per task on rayon's pool.
+//! Parallel batch ray casts [sources: parallel]: one ray per task on rayon's pool.
 
 use super::ray::RayHit;
 use super::tree::Bvh;

@@ -115,7 +115,7 @@ impl RayBvh {
     /// Builds a [`Bvh<Aabb>`] down to one triangle per leaf with `options.split`,
     /// then re-lays it out for rays: a subtree of at most `options.leaf_size`
     /// triangles becomes one leaf where the surface-area cost model says testing
-    /// its triangles is cheaper than descending (see [`Plan::sah`]), and the
+    /// its triangles is cheaper than descending (see the private `Plan::sah`), and the
     /// 4-wide nodes pull up the grandchildren of largest surface area. O(n log n).
     ///
     /// Fails on `leaf_size == 0`.

@@ -1,5 +1,5 @@
-//! Refitting: bottom-up after deformation, and the seed's exact refit of a rotated
-//! tree.
+//! Refitting: bottom-up after deformation, and the source's exact refit of a rotated
+//! tree [sources: bvh-rotate].
 
 use super::tree::{coord_bound, Bvh};
 use crate::narrow::bv::BoundingVolume;
@@ -38,7 +38,7 @@ impl<BV: BoundingVolume> Bvh<BV> {
         Ok(())
     }
 
-    /// The seed's rotation update: every node's volume recomputed from the
+    /// The source's rotation update [sources: bvh-rotate]: every node's volume recomputed from the
     /// transformed vertices `world` (leaves from their triangles, internal nodes by
     /// merging), written to `out[i]` for node `i`. Exact for AABB and k-DOPs (the
     /// k-DOP of a union is the merge of the k-DOPs). Leaves are enlarged by `slack`

@@ -1,4 +1,4 @@
-//! Simultaneous traversal of two BVHs (seed 003, Fig. 2).
+//! Simultaneous traversal of two BVHs [sources: bvh-traverse].
 
 use super::tree::Bvh;
 use crate::narrow::bv::BoundingVolume;
@@ -79,7 +79,7 @@ impl<BV: BoundingVolume> VolumeSource<BV> for Lazy<'_, BV> {
 
 /// Descends both trees from their roots: a pair of nodes whose volumes overlap is
 /// split on the side that is not a leaf, or on the larger volume when neither is
-/// (seed 003, Fig. 2 with the usual "descend the larger" refinement); a pair of
+/// ([sources: bvh-traverse], with the usual "descend the larger" refinement); a pair of
 /// overlapping leaves goes to `leaf(a_node, b_node)`, which returns true to stop.
 /// Each pair of leaves is reached at most once, so each triangle pair is tested at
 /// most once. Counts volume tests in `nv`. Returns true if stopped early.

@@ -44,7 +44,7 @@ impl<BV> Node<BV> {
 /// The tree keeps its own copy of the triangles' vertex indices, permuted so that
 /// each leaf covers a contiguous range, and reads vertex *positions* from the mesh
 /// at query time: after [`TriMesh::set_vertices`](crate::narrow::TriMesh::set_vertices)
-/// call [`Bvh::refit`]. Built by [`Bvh::build`] (seed 003: top-down, binary).
+/// call [`Bvh::refit`]. Built by [`Bvh::build`] (top-down, binary: [sources: bvh-build]).
 #[derive(Clone, Debug)]
 pub struct Bvh<BV> {
     pub(crate) nodes: Vec<Node<BV>>,

@@ -84,6 +84,7 @@ std::vector<Line> parse(const std::string& path, std::map<std::string, peers::Me
             l.name = w[1];
             if (meshes.count(w[1])) die(where + "mesh '" + w[1] + "' already defined");
             std::string file = w[2][0] == '/' ? w[2] : dir_of(path) + "/" + w[2];
+            if (!std::ifstream(file)) die(where + "cannot open mesh file " + file);
             meshes[w[1]] = peers::load_mesh(file);
         } else if (w[0] == "add") {
             arity(2);
@@ -144,8 +145,12 @@ struct World {
     std::string trace;
     const std::map<std::string, std::shared_ptr<Model>>& models;
     fcl::DynamicAABBTreeCollisionManagerd manager;
-    std::unordered_map<uint64_t, std::unique_ptr<Object>> objects;
-    std::unordered_map<const Object*, uint64_t> ids;
+    // Each object's user data points at its id (read in the pair callback).
+    struct Entry {
+        uint64_t id;
+        std::unique_ptr<Object> obj;
+    };
+    std::unordered_map<uint64_t, std::unique_ptr<Entry>> objects;
     std::set<std::pair<uint64_t, uint64_t>> ignored;
     std::vector<Object*> moved;
 
@@ -154,7 +159,7 @@ struct World {
     Object* find(uint64_t id, size_t line) {
         auto it = objects.find(id);
         if (it == objects.end()) die(trace + ": line " + std::to_string(line) + ": unknown id " + std::to_string(id));
-        return it->second.get();
+        return it->second->obj.get();
     }
 
     static std::pair<uint64_t, uint64_t> key(uint64_t a, uint64_t b) { return a < b ? std::make_pair(a, b) : std::make_pair(b, a); }
@@ -163,7 +168,11 @@ struct World {
 bool on_pair(Object* o1, Object* o2, void* data) {
     auto* d = static_cast<PairData*>(data);
     World& w = *d->world;
-    if (w.ignored.count(World::key(w.ids.at(o1), w.ids.at(o2)))) return false;
+    if (!w.ignored.empty()) {
+        uint64_t a = static_cast<const World::Entry*>(o1->getUserData())->id;
+        uint64_t b = static_cast<const World::Entry*>(o2->getUserData())->id;
+        if (w.ignored.count(World::key(a, b))) return false;
+    }
     d->res.clear();
     if (d->direct) {
         // The traversal fcl::collide would dispatch to for two OBBRSS meshes.
@@ -203,11 +212,13 @@ void run(const std::string& trace, const std::vector<Line>& ops, const std::map<
             case Op::Add: {
                 if (w.objects.count(l.id)) die(where + "id " + std::to_string(l.id) + " already in use");
                 uint64_t t0 = peers::now_ns();
-                auto obj = std::make_unique<Object>(models.at(l.name), fcl::Transform3d::Identity());
-                obj->computeAABB();
-                w.manager.registerObject(obj.get());
-                w.ids[obj.get()] = l.id;
-                w.objects[l.id] = std::move(obj);
+                auto e = std::make_unique<World::Entry>();
+                e->id = l.id;
+                e->obj = std::make_unique<Object>(models.at(l.name), fcl::Transform3d::Identity());
+                e->obj->setUserData(e.get());
+                e->obj->computeAABB();
+                w.manager.registerObject(e->obj.get());
+                w.objects[l.id] = std::move(e);
                 t.other_ns += peers::now_ns() - t0;
                 break;
             }
@@ -228,7 +239,6 @@ void run(const std::string& trace, const std::vector<Line>& ops, const std::map<
                 uint64_t t0 = peers::now_ns();
                 w.manager.unregisterObject(obj);
                 w.moved.erase(std::remove(w.moved.begin(), w.moved.end(), obj), w.moved.end());
-                w.ids.erase(obj);
                 // The pair list names objects, not ids: a later object with this
                 // id starts with no ignored pairs.
                 for (auto it = w.ignored.begin(); it != w.ignored.end();)

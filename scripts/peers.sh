@@ -58,7 +58,8 @@ PY
     say "installing libcoal==3.0.* and cmeel-eigen (pip, into $VENV)"
     "$VENV/bin/pip" install -q --disable-pip-version-check 'libcoal==3.0.*' cmeel-eigen
 fi
-CMEEL=$(ls -d "$VENV"/lib/python3*/site-packages/cmeel.prefix | head -1)
+prefixes=("$VENV"/lib/python3*/site-packages/cmeel.prefix)
+CMEEL=${prefixes[0]}
 [ -f "$CMEEL/lib/pkgconfig/coal.pc" ] || { say "no coal.pc under $CMEEL"; exit 1; }
 
 # --- build ------------------------------------------------------------------
@@ -99,12 +100,12 @@ EMBREE_FLAGS="$(pkg-config --cflags "$EMBREE_PC" 2>/dev/null) $(pkg-config --lib
 
 # Two compilers at a time (the machine has 2 cores); any failure fails the script.
 pids=()
-build w5_mesh-fcl "$SRC/w5_mesh.cpp" -- $FCL_FLAGS & pids+=($!)
-build w5_mesh-coal "$SRC/w5_mesh.cpp" -- $COAL_FLAGS & pids+=($!)
+build w5_mesh-fcl "$SRC/w5_mesh.cpp" -- "$FCL_FLAGS" & pids+=($!)
+build w5_mesh-coal "$SRC/w5_mesh.cpp" -- "$COAL_FLAGS" & pids+=($!)
 for p in "${pids[@]}"; do wait "$p"; done
 pids=()
-build fcl_world "$SRC/fcl_world.cpp" -- $FCL_FLAGS & pids+=($!)
-build w6_rays "$SRC/w6_rays.cpp" -- $EMBREE_FLAGS & pids+=($!)
+build fcl_world "$SRC/fcl_world.cpp" -- "$FCL_FLAGS" & pids+=($!)
+build w6_rays "$SRC/w6_rays.cpp" -- "$EMBREE_FLAGS" & pids+=($!)
 for p in "${pids[@]}"; do wait "$p"; done
 
 # `w5_mesh --lib fcl|coal ...`: one name for both builds (FCL and coal cannot

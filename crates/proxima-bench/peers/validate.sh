@@ -10,7 +10,7 @@
 # coal and Embree decide touching and grazing cases with their own tolerances).
 set -uo pipefail
 ROOT=$(cd "$(dirname "$0")/../../.." && pwd)
-cd "$ROOT"
+cd "$ROOT" || exit 1
 PEERS=$ROOT/crates/proxima-bench/peers
 BIN=target/peers
 PX=target/release/proxima

@@ -4,16 +4,36 @@
 use crate::geom::Ray;
 use glam::{DVec3, Vec3, Vec3A, Vec4};
 
-/// Where a ray meets a triangle: parameter `t` and barycentrics `(u, v)` with the
-/// hit point `(1-u-v)·a + u·b + v·c`.
+/// Where a ray meets a mesh: which triangle, at which ray parameter `t`, and the
+/// barycentrics `(u, v)` of the hit point `(1-u-v)·a + u·b + v·c` on that
+/// triangle's corners `a, b, c`. The one hit type of every narrow-phase cast
+/// ([`Mesh`](crate::narrow::Mesh), [`Bvh`](crate::narrow::Bvh),
+/// [`RayBvh`](crate::narrow::RayBvh), and [`ray_triangle`] on a lone triangle).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleHit {
-    /// Ray parameter (in units of `ray.dir`), in `[0, ray.max_t]`.
+    /// Index of the triangle in the mesh (`0` from [`ray_triangle`]: a lone
+    /// triangle is triangle 0 of a one-triangle mesh).
+    pub triangle: u32,
+    /// Ray parameter (in units of `ray.dir`; for a segment, 0 at `a`, 1 at `b`),
+    /// in `[0, ray.max_t]`.
     pub t: f32,
     /// Weight of the second corner.
     pub u: f32,
     /// Weight of the third corner.
     pub v: f32,
+}
+
+impl TriangleHit {
+    /// The mesh casts' order of hits: this hit comes before `best` if it is
+    /// nearer, or as near on a smaller triangle index. Every mesh cast keeps the
+    /// first hit in this order (as the tests' brute force does), so its answer
+    /// never depends on the order in which triangles are tested.
+    #[inline(always)]
+    pub(crate) fn precedes(&self, best: &Option<TriangleHit>) -> bool {
+        best.map_or(true, |b| {
+            self.t < b.t || (self.t == b.t && self.triangle < b.triangle)
+        })
+    }
 }
 
 /// Closed ray–triangle test: the hit with `0 <= t <= ray.max_t`, edges and corners
@@ -24,7 +44,7 @@ pub struct TriangleHit {
 /// from `f32` inputs (translation exact in most cases, far fewer rounding ties).
 ///
 /// A triangle seen exactly edge-on (zero sheared area), including every degenerate
-/// triangle, is never hit. O(1).
+/// triangle, is never hit. The hit's `triangle` is 0. O(1).
 pub fn ray_triangle(ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit> {
     WoopRay::new(ray).hit(tri)
 }
@@ -71,7 +91,7 @@ impl WoopRay {
         }
     }
 
-    /// The test of one triangle (see [`ray_triangle`]).
+    /// The test of one triangle (see [`ray_triangle`]); the hit names triangle 0.
     #[inline]
     pub(crate) fn hit(&self, tri: &[Vec3; 3]) -> Option<TriangleHit> {
         let (kx, ky, kz) = (self.k[0] & 3, self.k[1] & 3, self.k[2] & 3);
@@ -100,6 +120,7 @@ impl WoopRay {
             return None;
         }
         Some(TriangleHit {
+            triangle: 0,
             t: t as f32,
             u: (v / det) as f32,
             v: (w / det) as f32,

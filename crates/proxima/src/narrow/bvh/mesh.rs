@@ -23,8 +23,8 @@ use std::sync::OnceLock;
 ///   volume on W5), built at construction with the given [`BuildOptions`];
 /// - the ray tree, a [`RayBvh`], built on the first ray cast (or by
 ///   [`Mesh::ray_bvh`]), so that a mesh that is only ever collided (most shapes
-///   of a collision world) never pays its memory (~135 bytes per triangle, about
-///   twice the collision tree's). With the default options it is laid out from
+///   of a collision world) never pays its memory (~135 bytes per triangle plus
+///   128 per 4-wide node). With the default options it is laid out from
 ///   the collision tree's own topology in O(n) (a separate
 ///   [`RayBvh::build`] would rebuild that topology in O(n log n));
 /// - its bounds: an [`Aabb`], and a bounding [`Sphere`] around the box's centre,

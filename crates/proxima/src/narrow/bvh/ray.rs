@@ -71,12 +71,9 @@ impl<BV: BoundingVolume> Bvh<BV> {
                     }
                     let w = woop.get_or_insert_with(|| WoopRay::new(ray));
                     if let Some(h) = w.hit(&tri) {
-                        let h = TriangleHit {
-                            triangle: self.ids[k],
-                            ..h
-                        };
-                        if h.precedes(&best) {
-                            best = Some(h);
+                        let id = self.ids[k];
+                        if h.precedes(id, &best) {
+                            best = Some(h.on(id));
                             if any {
                                 return best;
                             }

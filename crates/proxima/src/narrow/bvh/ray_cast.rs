@@ -264,12 +264,9 @@ impl RayBvh {
             let Some(h) = w.hit(&[t.v[0].into(), t.v[1].into(), t.v[2].into()]) else {
                 continue;
             };
-            let h = TriangleHit {
-                triangle: self.ids[k as usize],
-                ..h
-            };
-            if h.precedes(best) {
-                *best = Some(h);
+            let id = self.ids[k as usize];
+            if h.precedes(id, best) {
+                *best = Some(h.on(id));
                 if any {
                     return true;
                 }

@@ -112,17 +112,18 @@ impl<BV: BoundingVolume> Bvh<BV> {
     /// its volumes were last fitted to. O(1).
     pub(crate) fn check_mesh(&self, mesh: &TriMesh) -> Result<()> {
         let s = mesh.stamp();
+        // Geometry stamps are never reused: equal ones mean the same topology too.
+        if s.geometry == self.mesh.geometry {
+            return Ok(());
+        }
         if s.topology != self.mesh.topology {
             return Err(Error::MeshMismatch(
                 "the BVH was built over another mesh".into(),
             ));
         }
-        if s.geometry != self.mesh.geometry {
-            return Err(Error::MeshMismatch(
-                "the mesh's vertices changed since the BVH was built or refit (refit it)".into(),
-            ));
-        }
-        Ok(())
+        Err(Error::MeshMismatch(
+            "the mesh's vertices changed since the BVH was built or refit (refit it)".into(),
+        ))
     }
 }
 

@@ -12,7 +12,7 @@
 //! - [`registry`]: the list of structures (one line per index);
 //! - [`w5`]: the mesh-vs-mesh workload W5 and its peer [`parry_mesh`];
 //! - [`w6`]: rays vs one mesh (its own runner, table and agreement check), with
-//!   the peers [`obvhs_peer`], [`bvh_peer`] and [`parry_mesh_peer`];
+//!   its peers (obvhs, bvh, parry3d's `TriMesh`) beside it, as W4's are;
 //! - [`run`]: timing and the pair-count ledger; [`report`]: tables and JSON;
 //! - [`chart`]: an SVG bar chart of any workload's `--json` output.
 //!
@@ -20,12 +20,9 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod bvh_peer;
 pub mod chart;
-pub mod obvhs_peer;
 pub mod parry;
 pub mod parry_mesh;
-pub mod parry_mesh_peer;
 pub mod registry;
 pub mod report;
 pub mod run;

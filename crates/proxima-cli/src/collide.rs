@@ -18,7 +18,7 @@
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::{Affine3A, Mat3, Vec3};
 use proxima::narrow::{
-    BoundingVolume, BuildOptions, Bvh, Collider, CostCounters, Kdop14, Kdop18, Kdop26, Obb,
+    BoundingVolume, BuildOptions, Collider, CostCounters, Kdop14, Kdop18, Kdop26, Mesh, Obb,
     RotationUpdate, SplitRule, TriMesh,
 };
 use std::fmt::Write as _;
@@ -184,35 +184,35 @@ fn run(args: &[String]) -> Result<String, String> {
         }
     };
     match args.bv.as_str() {
-        "aabb" => queries::<Aabb>(&args, &a, &b, &poses),
-        "kdop14" => queries::<Kdop14>(&args, &a, &b, &poses),
-        "kdop26" => queries::<Kdop26>(&args, &a, &b, &poses),
-        "obb" => queries::<Obb>(&args, &a, &b, &poses),
-        "sphere" => queries::<Sphere>(&args, &a, &b, &poses),
-        _ => queries::<Kdop18>(&args, &a, &b, &poses),
+        "aabb" => queries::<Aabb>(&args, a, b, &poses),
+        "kdop14" => queries::<Kdop14>(&args, a, b, &poses),
+        "kdop26" => queries::<Kdop26>(&args, a, b, &poses),
+        "obb" => queries::<Obb>(&args, a, b, &poses),
+        "sphere" => queries::<Sphere>(&args, a, b, &poses),
+        _ => queries::<Kdop18>(&args, a, b, &poses),
     }
 }
 
 fn queries<BV: BoundingVolume>(
     args: &Args,
-    a: &TriMesh,
-    b: &TriMesh,
+    a: TriMesh,
+    b: TriMesh,
     poses: &[Affine3A],
 ) -> Result<String, String> {
-    let ta = Bvh::<BV>::build(a, args.build).map_err(|e| e.to_string())?;
-    let tb = Bvh::<BV>::build(b, args.build).map_err(|e| e.to_string())?;
+    let a = Mesh::<BV>::from_trimesh(a, args.build).map_err(|e| e.to_string())?;
+    let b = Mesh::<BV>::from_trimesh(b, args.build).map_err(|e| e.to_string())?;
     let mut collider = Collider::<BV>::new(args.rotation);
     let mut results: Vec<(usize, CostCounters)> = Vec::with_capacity(poses.len());
     let start = Instant::now();
     for pose in poses {
         let r = if args.first {
             let f = collider
-                .first_contact((&ta, a), pose, (&tb, b))
+                .first_contact(&a, pose, &b)
                 .map_err(|e| e.to_string())?;
             (f.pair.is_some() as usize, f.counters)
         } else {
             let c = collider
-                .all_pairs((&ta, a), pose, (&tb, b))
+                .all_pairs(&a, pose, &b)
                 .map_err(|e| e.to_string())?;
             (c.pairs.len(), c.counters)
         };
@@ -225,8 +225,8 @@ fn queries<BV: BoundingVolume>(
             elapsed.as_secs_f64() * 1e6 / poses.len().max(1) as f64,
             poses.len(),
             BV::NAME,
-            a.len(),
-            b.len()
+            a.trimesh().len(),
+            b.trimesh().len()
         );
     }
     let mut out = String::new();

@@ -18,7 +18,7 @@ use crate::pictures;
 use crate::trace::{Op, Trace};
 use proxima::geom::Sphere;
 use proxima::glam::Affine3A;
-use proxima::narrow::{Bvh, Collider, Kdop18, RotationUpdate};
+use proxima::narrow::Mesh;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -150,18 +150,16 @@ fn collide(args: &Args, files: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
         Affine3A::IDENTITY
     };
     let opts = Default::default();
-    let ta = Bvh::<Kdop18>::build(&a, opts).map_err(|e| e.to_string())?;
-    let tb = Bvh::<Kdop18>::build(&b, opts).map_err(|e| e.to_string())?;
-    let contacts = Collider::<Kdop18>::new(RotationUpdate::Auto)
-        .all_pairs((&ta, &a), &pose, (&tb, &b))
-        .map_err(|e| e.to_string())?;
+    let a: Mesh = Mesh::from_trimesh(a, opts).map_err(|e| e.to_string())?;
+    let b: Mesh = Mesh::from_trimesh(b, opts).map_err(|e| e.to_string())?;
+    let contacts = a.collide(&pose, &b).map_err(|e| e.to_string())?;
     println!("pairs {}", contacts.pairs.len());
     let (sa, sb) = (stem(&files[0]), stem(&files[1]));
     let c = pictures::meshes(
         &format!("{sa} (posed) vs {sb}: intersecting triangles"),
-        &a,
+        a.trimesh(),
         &pose,
-        &b,
+        b.trimesh(),
         &contacts.pairs,
     );
     Ok(vec![save(args, &c, &format!("collide-{sa}-{sb}"))?])

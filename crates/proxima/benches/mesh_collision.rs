@@ -10,7 +10,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::{Affine3A, Quat, Vec3};
 use proxima::narrow::{
-    BoundingVolume, BuildOptions, Bvh, Collider, CostCounters, Kdop14, Kdop18, Kdop26, Obb,
+    BoundingVolume, BuildOptions, Collider, CostCounters, Kdop14, Kdop18, Kdop26, Mesh, Obb,
     RotationUpdate, SplitRule, TriMesh,
 };
 use rand::{Rng, SeedableRng};
@@ -59,8 +59,8 @@ fn run_all<BV: BoundingVolume>(
     rotation: RotationUpdate,
     tag: &str,
 ) {
-    let ta = Bvh::<BV>::build(case.a, build).unwrap();
-    let tb = Bvh::<BV>::build(case.b, build).unwrap();
+    let ma = Mesh::<BV>::from_trimesh(case.a.clone(), build).unwrap();
+    let mb = Mesh::<BV>::from_trimesh(case.b.clone(), build).unwrap();
     let mut col = Collider::<BV>::new(rotation);
     for first in [false, true] {
         // Counters and a quick timing for the summary line.
@@ -69,11 +69,11 @@ fn run_all<BV: BoundingVolume>(
         let start = Instant::now();
         for p in case.poses {
             let k = if first {
-                let f = col.first_contact((&ta, case.a), p, (&tb, case.b)).unwrap();
+                let f = col.first_contact(&ma, p, &mb).unwrap();
                 pairs += f.pair.is_some() as usize;
                 f.counters
             } else {
-                let r = col.all_pairs((&ta, case.a), p, (&tb, case.b)).unwrap();
+                let r = col.all_pairs(&ma, p, &mb).unwrap();
                 pairs += r.pairs.len();
                 r.counters
             };
@@ -98,9 +98,9 @@ fn run_all<BV: BoundingVolume>(
             bch.iter(|| {
                 for p in case.poses {
                     if first {
-                        black_box(col.first_contact((&ta, case.a), p, (&tb, case.b)).unwrap());
+                        black_box(col.first_contact(&ma, p, &mb).unwrap());
                     } else {
-                        black_box(col.all_pairs((&ta, case.a), p, (&tb, case.b)).unwrap());
+                        black_box(col.all_pairs(&ma, p, &mb).unwrap());
                     }
                 }
             })

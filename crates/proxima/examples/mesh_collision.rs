@@ -4,20 +4,23 @@
 //! `cargo run --release --example mesh_collision [A.obj B.obj]`
 
 use proxima::glam::{Affine3A, Quat, Vec3};
-use proxima::narrow::{BuildOptions, Bvh, Collider, Kdop18, RotationUpdate};
+use proxima::narrow::{Collider, Mesh};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
     let mut args = std::env::args().skip(1);
     let a_path = args.next().unwrap_or(format!("{data}/rob.obj"));
     let b_path = args.next().unwrap_or(format!("{data}/env.obj"));
-    let a = proxima::io::load(&a_path)?;
-    let b = proxima::io::load(&b_path)?;
-    // One k-DOP (18 directions) hierarchy per mesh, built once.
-    let ta = Bvh::<Kdop18>::build(&a, BuildOptions::default())?;
-    let tb = Bvh::<Kdop18>::build(&b, BuildOptions::default())?;
-    let mut collider = Collider::<Kdop18>::new(RotationUpdate::Auto);
-    println!("A: {} triangles, B: {} triangles", a.len(), b.len());
+    // Each mesh with its k-DOP (18 directions) hierarchy, built once.
+    let a: Mesh = Mesh::load(&a_path)?;
+    let b: Mesh = Mesh::load(&b_path)?;
+    // Scratch space reused by every query.
+    let mut collider = Collider::default();
+    println!(
+        "A: {} triangles, B: {} triangles",
+        a.trimesh().len(),
+        b.trimesh().len()
+    );
 
     for step in 0..6 {
         // Slide A along y past a chair while turning it about z.
@@ -26,8 +29,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             Quat::from_rotation_z(t * 0.1),
             Vec3::new(-1500.0, -1800.0 + 150.0 * t, 450.0),
         );
-        let contacts = collider.all_pairs((&ta, &a), &pose, (&tb, &b))?;
-        let first = collider.first_contact((&ta, &a), &pose, (&tb, &b))?;
+        let contacts = collider.all_pairs(&a, &pose, &b)?;
+        let first = collider.first_contact(&a, &pose, &b)?;
         let c = contacts.counters;
         println!(
             "pose {step}: {:3} intersecting triangle pairs (first contact: {:?}); \

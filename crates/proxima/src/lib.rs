@@ -5,10 +5,14 @@
 //! - [`geom`]: the primitive shapes (`Sphere`, `Aabb`, `Ray`, `Segment`, `Plane`,
 //!   `Frustum`) and the one implementation of every closed overlap test between them.
 //! - [`broad`]: the [`broad::SpatialIndex`] trait over bounding spheres and its
-//!   indices: [`broad::BruteForce`] (the oracle) and the loose k-d tree
-//!   [sources: kd-tree], with more to come.
-//! - [`narrow`]: triangle meshes and the exact, closed triangle–triangle test.
-//! - [`io`]: OBJ, STL and PLY loaders into a [`narrow::TriMesh`].
+//!   indices: [`broad::BruteForce`] (the oracle) and the loose k-d tree of the first
+//!   source document, with more to come.
+//! - [`narrow`]: [`narrow::Mesh`], a triangle mesh that owns its trees: a k-DOP,
+//!   OBB, AABB or sphere BVH for exact mesh–mesh collision down to the closed
+//!   triangle–triangle test, and a 4-wide BVH for exact ray casts; the generic
+//!   [`narrow::Bvh`] below it for experiments with the source's choices [sources: bvh].
+//! - [`io`]: OBJ, STL and PLY loaders into a [`narrow::TriMesh`], or with
+//!   [`narrow::Mesh::load`] straight into a mesh with its trees.
 //!
 //! Math types are [`glam`]'s (`f32`), re-exported as [`proxima::glam`](glam) so that
 //! users need not match versions by hand.
@@ -22,7 +26,7 @@ pub mod geom;
 pub mod io;
 pub mod narrow;
 
-pub use error::{Error, FileLocation, Result};
+pub use error::{Error, FileLocation, IoError, Result};
 pub use glam;
 
 /// The root README's examples, compiled and run as doctests (`cargo test`).

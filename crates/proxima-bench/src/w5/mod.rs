@@ -28,7 +28,7 @@ use check::Disagreements;
 use ours::BvRun;
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::Affine3A;
-use proxima::narrow::{Kdop14, Kdop18, Kdop26, Obb, RotationUpdate, TriMesh};
+use proxima::narrow::{Kdop14, Kdop18, Kdop26, Mesh, Obb, RotationUpdate, TriMesh};
 use std::fmt::Write as _;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -253,8 +253,8 @@ fn run_parry(
     // Our pairs per pose again (sorted), for the pair-level comparison: taken
     // from the exact oracle of the collider, untimed.
     let opts = proxima::narrow::BuildOptions::default();
-    let ta = proxima::narrow::Bvh::<Obb>::build(a, opts).map_err(|e| e.to_string())?;
-    let tb = proxima::narrow::Bvh::<Obb>::build(b, opts).map_err(|e| e.to_string())?;
+    let ma = Mesh::<Obb>::from_trimesh(a.clone(), opts).map_err(|e| e.to_string())?;
+    let mb = Mesh::<Obb>::from_trimesh(b.clone(), opts).map_err(|e| e.to_string())?;
     let mut col = proxima::narrow::Collider::<Obb>::default();
     for (i, p) in poses.iter().enumerate() {
         let pp = parry_mesh::pose(p);
@@ -266,10 +266,7 @@ fn run_parry(
         r.all.push(t);
         r.pair_total += pairs.len() as u64;
         pairs.sort_unstable();
-        let mut mine = col
-            .all_pairs((&ta, a), p, (&tb, b))
-            .map_err(|e| e.to_string())?
-            .pairs;
+        let mut mine = col.all_pairs(&ma, p, &mb).map_err(|e| e.to_string())?.pairs;
         mine.sort_unstable();
         if mine.len() as u64 != ours.counts[i] {
             return Err(format!("pose {i}: OBB recount differs"));

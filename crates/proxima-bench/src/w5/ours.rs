@@ -3,7 +3,7 @@
 
 use crate::run::Clock;
 use proxima::glam::Affine3A;
-use proxima::narrow::{BoundingVolume, BuildOptions, Bvh, Collider, RotationUpdate, TriMesh};
+use proxima::narrow::{BoundingVolume, BuildOptions, Collider, Mesh, RotationUpdate, TriMesh};
 use std::time::Duration;
 
 /// One bounding-volume type on one mesh pair.
@@ -40,10 +40,17 @@ pub fn measure<BV: BoundingVolume>(
     rotation: RotationUpdate,
 ) -> Result<BvRun, String> {
     let opts = BuildOptions::default();
-    let (trees, build) = clock.time(|| (Bvh::<BV>::build(a, opts), Bvh::<BV>::build(b, opts)));
-    let (ta, tb) = (
-        trees.0.map_err(|e| e.to_string())?,
-        trees.1.map_err(|e| e.to_string())?,
+    // The copies of the geometry are made outside the build's clock.
+    let (a, b) = (a.clone(), b.clone());
+    let (meshes, build) = clock.time(|| {
+        (
+            Mesh::<BV>::from_trimesh(a, opts),
+            Mesh::<BV>::from_trimesh(b, opts),
+        )
+    });
+    let (ma, mb) = (
+        meshes.0.map_err(|e| e.to_string())?,
+        meshes.1.map_err(|e| e.to_string())?,
     );
     let mut col = Collider::<BV>::new(rotation);
     let mut r = BvRun {
@@ -60,11 +67,10 @@ pub fn measure<BV: BoundingVolume>(
     };
     // Warm-up: scratch buffers sized, code and data in cache.
     if let Some(p) = poses.first() {
-        col.all_pairs((&ta, a), p, (&tb, b))
-            .map_err(|e| e.to_string())?;
+        col.all_pairs(&ma, p, &mb).map_err(|e| e.to_string())?;
     }
     for (i, p) in poses.iter().enumerate() {
-        let (c, t) = clock.time(|| col.all_pairs((&ta, a), p, (&tb, b)));
+        let (c, t) = clock.time(|| col.all_pairs(&ma, p, &mb));
         let c = c.map_err(|e| e.to_string())?;
         r.all.push(t);
         r.counts.push(c.pairs.len() as u64);
@@ -76,7 +82,7 @@ pub fn measure<BV: BoundingVolume>(
             s.sort_unstable();
             r.sample.push(s);
         }
-        let (f, t) = clock.time(|| col.first_contact((&ta, a), p, (&tb, b)));
+        let (f, t) = clock.time(|| col.first_contact(&ma, p, &mb));
         let f = f.map_err(|e| e.to_string())?;
         r.first.push(t);
         r.hits.push(f.pair.is_some());

@@ -3,7 +3,8 @@
 //! hit/miss and `t` within a small relative tolerance, and every ray they disagree
 //! on is re-cast by brute force to confirm our answer and classified.
 
-use super::structures::{Answer, Brute, RayCaster};
+use super::caster::{Answer, RayCaster};
+use super::structures::Brute;
 use proxima::geom::Ray;
 use proxima::glam::DVec3;
 use proxima::narrow::TriMesh;

@@ -12,7 +12,11 @@
 //! and on every ray a peer disagrees on); peers may differ on grazing rays (their
 //! `f32` Möller tests are not watertight), and those rays are counted.
 
+pub mod bvh_peer;
+pub mod caster;
 pub mod check;
+pub mod obvhs_peer;
+pub mod parry_mesh_peer;
 pub mod rays;
 pub mod structures;
 
@@ -23,7 +27,6 @@ use proxima::narrow::{BuildOptions, SplitRule, TriMesh};
 use std::fmt::Write;
 use std::process::ExitCode;
 use std::time::Duration;
-pub use structures::RayCaster;
 
 const USAGE: &str = "usage: proxima-bench w6 [--mesh NAME,NAME] [--rays R] [--threads 1,2] [--repeats N] [--leaf L] [--seed S] [--only A,B] [--clock cpu|wall] [--json]";
 

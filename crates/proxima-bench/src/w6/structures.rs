@@ -1,75 +1,52 @@
-//! The W6 structures: Proxima's BVH with every bounding volume, brute force, and
-//! the peers, behind one object-safe interface.
+//! The W6 structures: Proxima's mesh (its ray tree) and its BVH with every
+//! bounding volume, brute force, and the peers, behind one object-safe interface.
 
-use crate::bvh_peer::BvhCrate;
-use crate::obvhs_peer::Obvhs;
-use crate::parry_mesh_peer::ParryMesh;
+use super::bvh_peer::BvhCrate;
+use super::caster::{Answer, RayCaster};
+use super::obvhs_peer::Obvhs;
+use super::parry_mesh_peer::ParryMesh;
 use proxima::geom::{Aabb, Ray, Sphere};
 use proxima::narrow::{
-    ray_triangle, BoundingVolume, BuildOptions, Bvh, Kdop14, Kdop18, Kdop26, Obb, RayBvh, TriMesh,
+    ray_triangle, BoundingVolume, BuildOptions, Kdop14, Kdop18, Kdop26, Mesh, Obb, TriMesh,
+    TriangleHit,
 };
-use rayon::prelude::*;
 
-/// A closest hit: `(mesh triangle, t)`, or `None` for a miss.
-pub type Answer = Option<(u32, f32)>;
-
-/// A closest-hit ray caster over one mesh: `(mesh triangle, t)` or `None`.
-pub trait RayCaster: Sync {
-    /// The closest hit of a valid ray.
-    fn cast(&self, ray: &Ray) -> Option<(u32, f32)>;
-
-    /// Every ray of a batch on the current rayon pool (the generic `par_iter`; ours
-    /// override it with the library's batch helper).
-    fn cast_par(&self, rays: &[Ray]) -> Vec<Option<(u32, f32)>> {
-        rays.par_iter()
-            .with_min_len(256)
-            .map(|r| self.cast(r))
-            .collect()
-    }
+fn answer(h: Option<TriangleHit>) -> Answer {
+    h.map(|h| (h.triangle, h.t))
 }
 
-/// Proxima's `Bvh<BV>` and its `cast_ray`.
-pub struct Proxima<BV: BoundingVolume> {
-    bvh: Bvh<BV>,
-    mesh: TriMesh,
-}
+/// Proxima's collision tree `Bvh<BV>` of a `Mesh<BV>` and its `cast_ray` (the
+/// source's volumes compared on rays, [sources: bv-kinds]).
+pub struct Proxima<BV: BoundingVolume>(Mesh<BV>);
 
 impl<BV: BoundingVolume> RayCaster for Proxima<BV> {
-    fn cast(&self, ray: &Ray) -> Option<(u32, f32)> {
-        self.bvh
-            .cast_ray(&self.mesh, ray)
-            .expect("valid ray")
-            .map(|h| (h.triangle, h.t))
+    fn cast(&self, ray: &Ray) -> Answer {
+        answer(
+            self.0
+                .bvh()
+                .cast_ray(self.0.trimesh(), ray)
+                .expect("valid ray"),
+        )
     }
 
-    fn cast_par(&self, rays: &[Ray]) -> Vec<Option<(u32, f32)>> {
-        self.bvh
-            .cast_rays_par(&self.mesh, rays)
-            .expect("valid rays")
-            .into_iter()
-            .map(|h| h.map(|h| (h.triangle, h.t)))
-            .collect()
+    fn cast_par(&self, rays: &[Ray]) -> Vec<Answer> {
+        let hits = self.0.bvh().cast_rays_par(self.0.trimesh(), rays);
+        hits.expect("valid rays").into_iter().map(answer).collect()
     }
 }
 
-/// Proxima's `RayBvh` (the ray layout of the SAH AABB tree).
-pub struct ProximaRay(RayBvh);
+/// Proxima's `Mesh::cast_ray` (its ray tree, a `RayBvh` laid out from the SAH
+/// tree).
+pub struct ProximaMesh(Mesh<Aabb>);
 
-impl RayCaster for ProximaRay {
-    fn cast(&self, ray: &Ray) -> Option<(u32, f32)> {
-        self.0
-            .cast_ray(ray)
-            .expect("valid ray")
-            .map(|h| (h.triangle, h.t))
+impl RayCaster for ProximaMesh {
+    fn cast(&self, ray: &Ray) -> Answer {
+        answer(self.0.cast_ray(ray).expect("valid ray"))
     }
 
-    fn cast_par(&self, rays: &[Ray]) -> Vec<Option<(u32, f32)>> {
-        self.0
-            .cast_rays_par(rays)
-            .expect("valid rays")
-            .into_iter()
-            .map(|h| h.map(|h| (h.triangle, h.t)))
-            .collect()
+    fn cast_par(&self, rays: &[Ray]) -> Vec<Answer> {
+        let hits = self.0.cast_rays_par(rays).expect("valid rays");
+        hits.into_iter().map(answer).collect()
     }
 }
 
@@ -77,7 +54,7 @@ impl RayCaster for ProximaRay {
 pub struct Brute(pub TriMesh);
 
 impl RayCaster for Brute {
-    fn cast(&self, ray: &Ray) -> Option<(u32, f32)> {
+    fn cast(&self, ray: &Ray) -> Answer {
         let mut best: Option<(u32, f32)> = None;
         for i in 0..self.0.len() {
             if let Some(h) = ray_triangle(ray, &self.0.triangle(i)) {
@@ -103,10 +80,21 @@ pub struct Entry {
 }
 
 fn proxima<BV: BoundingVolume>(m: &TriMesh, o: BuildOptions) -> Box<dyn RayCaster> {
-    Box::new(Proxima::<BV> {
-        bvh: Bvh::build(m, o).expect("valid options"),
-        mesh: m.clone(),
-    })
+    Box::new(Proxima(
+        Mesh::<BV>::from_trimesh(m.clone(), o).expect("valid options"),
+    ))
+}
+
+/// The mesh whose ray tree is built with `o`, built now (inside the build's
+/// clock, not in the first timed batch). Its collision tree is the SAH tree the
+/// ray tree is laid out from, so the build is that of a `RayBvh` alone.
+fn proxima_mesh(m: &TriMesh, o: BuildOptions) -> Box<dyn RayCaster> {
+    let binary = BuildOptions { leaf_size: 1, ..o };
+    let mesh = Mesh::<Aabb>::from_trimesh(m.clone(), binary)
+        .and_then(|mesh| mesh.with_ray_options(o))
+        .expect("valid options");
+    mesh.ray_bvh();
+    Box::new(ProximaMesh(mesh))
 }
 
 /// The name of the peer every ratio is taken against.
@@ -122,9 +110,7 @@ pub fn entries() -> Vec<Entry> {
     };
     vec![
         e("proxima-aabb", false, false, proxima::<Aabb>),
-        e("proxima-ray", false, false, |m, o| {
-            Box::new(ProximaRay(RayBvh::build(m, o).expect("valid options")))
-        }),
+        e("proxima-ray", false, false, proxima_mesh),
         e("proxima-kdop14", false, false, proxima::<Kdop14>),
         e("proxima-kdop18", false, false, proxima::<Kdop18>),
         e("proxima-kdop26", false, false, proxima::<Kdop26>),

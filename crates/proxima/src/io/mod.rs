@@ -1,5 +1,6 @@
 //! Mesh loading: OBJ, STL (binary and ASCII) and PLY (ASCII and binary) into a
-//! [`TriMesh`].
+//! [`TriMesh`] ([`load`], [`parse`]), or straight into a [`Mesh`] with its trees
+//! ([`Mesh::load`]).
 //!
 //! Every loader reads the whole file into memory once and never trusts a count
 //! in it: storage grows only with data actually read, so a lying header costs at
@@ -17,7 +18,7 @@ pub use obj::parse_obj;
 pub use ply::parse_ply;
 pub use stl::parse_stl;
 
-use crate::narrow::TriMesh;
+use crate::narrow::{BoundingVolume, BuildOptions, Mesh, TriMesh};
 use crate::{Error, FileLocation, Result};
 use glam::Vec3;
 use std::path::Path;
@@ -70,15 +71,23 @@ pub fn load(path: impl AsRef<Path>) -> Result<TriMesh> {
     let name = path.display().to_string();
     let data = std::fs::read(path).map_err(|e| Error::Io {
         file: name.clone(),
-        msg: e.to_string(),
+        source: e.into(),
     })?;
     let format = Format::from_extension(path)
         .or_else(|| Format::sniff(&data))
-        .ok_or_else(|| Error::Io {
-            file: name.clone(),
-            msg: "unknown mesh format (expected .obj, .stl or .ply)".into(),
-        })?;
+        .ok_or_else(|| Error::UnknownFormat { file: name.clone() })?;
     parse(&name, &data, format)
+}
+
+// Here, not in `narrow`: the narrow phase does not depend on the loaders.
+impl<BV: BoundingVolume> Mesh<BV> {
+    /// Loads a mesh file ([`load`]: OBJ, STL or PLY, by extension or content) and
+    /// builds its collision tree with [`BuildOptions::default`]
+    /// ([`Mesh::from_trimesh`]). Fails with the loader's error, which names the
+    /// file ([`Error::Io`], [`Error::UnknownFormat`], [`Error::Parse`]).
+    pub fn load(path: impl AsRef<Path>) -> Result<Mesh<BV>> {
+        Mesh::from_trimesh(load(path)?, BuildOptions::default())
+    }
 }
 
 /// Parses in-memory file content of a known format; `name` is used in errors.

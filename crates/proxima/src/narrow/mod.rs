@@ -1,10 +1,25 @@
-//! Narrow phase: triangle meshes, bounding-volume hierarchies over them, and
-//! mesh-vs-mesh collision down to exact triangle–triangle tests [sources: bvh, tri-tri].
+//! Narrow phase: triangle meshes, bounding-volume hierarchies over them, exact
+//! mesh–mesh collision down to triangle–triangle tests [sources: bvh, tri-tri], and
+//! ray casts.
+//!
+//! Start from [`Mesh`]: a triangle mesh that owns its collision tree and its ray
+//! tree. `Mesh::load(path)` reads an OBJ, STL or PLY file; [`Mesh::collide`] gives
+//! every intersecting triangle pair of two posed meshes, [`Mesh::cast_ray`] the
+//! closest [`TriangleHit`]; a [`Collider`] keeps the scratch space of a loop of
+//! collision queries.
+//!
+//! Below it, for experiments with the source's choices [sources: bvh]: [`TriMesh`] (the geometry
+//! alone); [`Bvh<BV>`](Bvh) over a `TriMesh`, generic over the
+//! [`BoundingVolume`] ([`Aabb`](crate::geom::Aabb), [`Kdop14`], [`Kdop18`],
+//! [`Kdop26`], [`Obb`], [`Sphere`](crate::geom::Sphere)) and the [`SplitRule`];
+//! [`RayBvh`], the 4-wide ray layout. And the exact primitive tests every query
+//! ends in: [`triangles_intersect`] (with [`PreparedTriangle`] for repeated tests),
+//! [`ray_triangle`], [`segments_intersect`], [`segment_triangle_intersect`].
 
-pub mod bv;
+mod bv;
 mod bvh;
 mod coplanar;
-pub mod predicates;
+pub(crate) mod predicates;
 mod prepared;
 mod ray_triangle;
 mod segment;
@@ -13,8 +28,8 @@ mod trimesh;
 
 pub use bv::{BoundingVolume, Kdop, Kdop14, Kdop18, Kdop26, Obb};
 pub use bvh::{
-    check_pose, collide_all, collide_first, BuildOptions, Bvh, Collider, Contacts, CostCounters,
-    FirstContact, Node, RayBvh, RayHit, RotationUpdate, SplitRule,
+    check_pose, BuildOptions, Bvh, Collider, Contacts, CostCounters, FirstContact, Mesh, Node,
+    RayBvh, RotationUpdate, SplitRule,
 };
 pub use prepared::PreparedTriangle;
 pub use ray_triangle::{ray_triangle, TriangleHit};

@@ -4,16 +4,57 @@
 use crate::geom::Ray;
 use glam::{DVec3, Vec3, Vec3A, Vec4};
 
-/// Where a ray meets a triangle: parameter `t` and barycentrics `(u, v)` with the
-/// hit point `(1-u-v)·a + u·b + v·c`.
+/// Where a ray meets a mesh: which triangle, at which ray parameter `t`, and the
+/// barycentrics `(u, v)` of the hit point `(1-u-v)·a + u·b + v·c` on that
+/// triangle's corners `a, b, c`. The one hit type of every narrow-phase cast
+/// ([`Mesh`](crate::narrow::Mesh), [`Bvh`](crate::narrow::Bvh),
+/// [`RayBvh`](crate::narrow::RayBvh), and [`ray_triangle`] on a lone triangle).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleHit {
-    /// Ray parameter (in units of `ray.dir`), in `[0, ray.max_t]`.
+    /// Index of the triangle in the mesh (`0` from [`ray_triangle`]: a lone
+    /// triangle is triangle 0 of a one-triangle mesh).
+    pub triangle: u32,
+    /// Ray parameter (in units of `ray.dir`; for a segment, 0 at `a`, 1 at `b`),
+    /// in `[0, ray.max_t]`.
     pub t: f32,
     /// Weight of the second corner.
     pub u: f32,
     /// Weight of the third corner.
     pub v: f32,
+}
+
+/// A hit on one triangle before it is named: `t` and the barycentrics `(u, v)`.
+/// Twelve bytes, so the per-triangle test returns it in registers; the casts
+/// name the triangle only for a hit that beats the best one ([`Hit::on`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Hit {
+    pub t: f32,
+    pub u: f32,
+    pub v: f32,
+}
+
+impl Hit {
+    /// The hit on triangle `triangle` of a mesh.
+    #[inline(always)]
+    pub(crate) fn on(self, triangle: u32) -> TriangleHit {
+        TriangleHit {
+            triangle,
+            t: self.t,
+            u: self.u,
+            v: self.v,
+        }
+    }
+
+    /// The mesh casts' order of hits: this hit, on `triangle`, comes before
+    /// `best` if it is nearer, or as near on a smaller triangle index. Every mesh
+    /// cast keeps the first hit in this order (as the tests' brute force does), so
+    /// its answer never depends on the order in which triangles are tested.
+    #[inline(always)]
+    pub(crate) fn precedes(&self, triangle: u32, best: &Option<TriangleHit>) -> bool {
+        best.map_or(true, |b| {
+            self.t < b.t || (self.t == b.t && triangle < b.triangle)
+        })
+    }
 }
 
 /// Closed ray–triangle test: the hit with `0 <= t <= ray.max_t`, edges and corners
@@ -24,14 +65,14 @@ pub struct TriangleHit {
 /// from `f32` inputs (translation exact in most cases, far fewer rounding ties).
 ///
 /// A triangle seen exactly edge-on (zero sheared area), including every degenerate
-/// triangle, is never hit. O(1).
+/// triangle, is never hit. The hit's `triangle` is 0. O(1).
 pub fn ray_triangle(ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit> {
-    WoopRay::new(ray).hit(tri)
+    WoopRay::new(ray).hit(tri).map(|h| h.on(0))
 }
 
 /// The per-ray part of [`ray_triangle`] (the dominant axis, the shear and the
 /// `f64` origin), computed once for many triangles: `WoopRay::new(ray).hit(tri)`
-/// *is* `ray_triangle(ray, tri)`, bit for bit.
+/// *is* `ray_triangle(ray, tri)`, bit for bit (before naming the triangle).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct WoopRay {
     /// The origin, permuted to `(kx, ky, kz)`.
@@ -73,7 +114,7 @@ impl WoopRay {
 
     /// The test of one triangle (see [`ray_triangle`]).
     #[inline]
-    pub(crate) fn hit(&self, tri: &[Vec3; 3]) -> Option<TriangleHit> {
+    pub(crate) fn hit(&self, tri: &[Vec3; 3]) -> Option<Hit> {
         let (kx, ky, kz) = (self.k[0] & 3, self.k[1] & 3, self.k[2] & 3);
         let (sx, sy, sz) = (self.s.x, self.s.y, self.s.z);
         // Translate to the origin, permute, shear: the same operations on the same
@@ -99,7 +140,7 @@ impl WoopRay {
         if t.is_nan() || t < 0.0 || t > self.max_t {
             return None;
         }
-        Some(TriangleHit {
+        Some(Hit {
             t: t as f32,
             u: (v / det) as f32,
             v: (w / det) as f32,

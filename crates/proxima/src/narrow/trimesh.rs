@@ -1,15 +1,59 @@
+//! [`TriMesh`]: validated triangle-mesh geometry (vertices and index triples).
+
 use crate::{Error, Result};
 use glam::Vec3;
+use std::fmt;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A triangle mesh: shared vertices and triangles as vertex-index triples.
 ///
 /// Validated on construction: at least one triangle, every index in range, every
 /// coordinate finite. Zero-area triangles (repeated or collinear vertices) are
 /// allowed; every algorithm in [`narrow`](crate::narrow) handles them.
-#[derive(Clone, Debug, PartialEq)]
+///
+/// This is the geometry alone; [`Mesh`](crate::narrow::Mesh) owns one together
+/// with its trees. A [`Bvh`](crate::narrow::Bvh) built over a `TriMesh` reads
+/// its vertices at query time, so it refuses any other mesh (even one with as
+/// many vertices), and this one after [`TriMesh::set_vertices`] until it is
+/// refit: a clone of the mesh, holding the same geometry, is accepted. O(1).
+#[derive(Clone)]
 pub struct TriMesh {
     vertices: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
+    stamp: MeshStamp,
+}
+
+/// Which mesh and which version of its vertices a tree was built or refit over,
+/// so that a tree given another mesh (or the same one, deformed and not refit)
+/// fails instead of answering wrongly: `topology` is new for every
+/// [`TriMesh::new`], `geometry` for every [`TriMesh::set_vertices`] too. A clone
+/// keeps both (it holds the same triangles and vertices). O(1) to compare.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct MeshStamp {
+    pub topology: u64,
+    pub geometry: u64,
+}
+
+/// A number never handed out before in this process.
+fn fresh() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
+
+impl PartialEq for TriMesh {
+    /// Equal geometry: the same vertices and triangles (wherever they came from).
+    fn eq(&self, other: &Self) -> bool {
+        self.vertices == other.vertices && self.triangles == other.triangles
+    }
+}
+
+impl fmt::Debug for TriMesh {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("TriMesh")
+            .field("vertices", &self.vertices)
+            .field("triangles", &self.triangles)
+            .finish()
+    }
 }
 
 impl TriMesh {
@@ -29,10 +73,21 @@ impl TriMesh {
                 )));
             }
         }
+        let id = fresh();
         Ok(TriMesh {
             vertices,
             triangles,
+            stamp: MeshStamp {
+                topology: id,
+                geometry: id,
+            },
         })
+    }
+
+    /// The mesh's identity and vertex version (see [`MeshStamp`]).
+    #[inline]
+    pub(crate) fn stamp(&self) -> MeshStamp {
+        self.stamp
     }
 
     /// The vertices.
@@ -84,7 +139,9 @@ impl TriMesh {
     }
 
     /// Replaces the vertex positions (same count), e.g. for a deformed mesh; the
-    /// caller then refits its BVH. Fails, changing nothing, on a count mismatch or a
+    /// caller then refits its BVHs ([`Bvh::refit`](crate::narrow::Bvh::refit)),
+    /// which refuse the mesh until then. ([`Mesh::set_vertices`](crate::narrow::Mesh::set_vertices)
+    /// does both.) O(vertices). Fails, changing nothing, on a count mismatch or a
     /// non-finite coordinate.
     pub fn set_vertices(&mut self, vertices: &[Vec3]) -> Result<()> {
         if vertices.len() != self.vertices.len() {
@@ -98,6 +155,7 @@ impl TriMesh {
             return Err(Error::InvalidMesh(format!("vertex {i} is not finite")));
         }
         self.vertices.copy_from_slice(vertices);
+        self.stamp.geometry = fresh();
         Ok(())
     }
 }

@@ -9,7 +9,7 @@ use proxima::geom::{Aabb, Ray, Segment, Sphere};
 use proxima::glam::{Affine3A, Vec3};
 use proxima::narrow::{
     ray_triangle, triangles_intersect, BoundingVolume, BuildOptions, Bvh, Collider, Kdop14, Kdop18,
-    Kdop26, Obb, RotationUpdate, SplitRule, TriMesh,
+    Kdop26, Mesh, Obb, RayBvh, RotationUpdate, SplitRule, TriMesh,
 };
 use proxima::Error;
 use rand::{Rng, SeedableRng};
@@ -65,7 +65,7 @@ fn check_structure<BV: BoundingVolume>(m: &TriMesh) {
     for split in SPLITS {
         for leaf in [1, 3, 8] {
             let t = Bvh::<BV>::build(m, opts(split, leaf)).unwrap();
-            t.validate(m.vertices()).unwrap();
+            t.validate(m).unwrap();
             if split == SplitRule::Median {
                 let bound = ((m.len() as f64 / leaf as f64).log2().ceil() as usize) + 2;
                 assert!(t.depth() <= bound, "{} depth {}", BV::NAME, t.depth());
@@ -100,17 +100,35 @@ fn structure_every_bv_and_split() {
 #[test]
 fn bad_input_is_an_error() {
     let m = torus(3.0, 1.0, 8, 6);
+    // A leaf size of 0 is a bad parameter, for every tree and for a mesh.
     assert!(matches!(
         Bvh::<Kdop18>::build(&m, opts(SplitRule::Mean, 0)),
-        Err(Error::Invalid(_))
+        Err(Error::InvalidParameter(_))
     ));
-    let mut t = Bvh::<Kdop18>::build(&m, BuildOptions::default()).unwrap();
-    let before = t.nodes().to_vec();
-    assert!(t.refit(&m.vertices()[1..]).is_err());
+    assert!(matches!(
+        RayBvh::build(&m, opts(SplitRule::Sah, 0)),
+        Err(Error::InvalidParameter(_))
+    ));
+    assert!(matches!(
+        Mesh::<Kdop18>::from_trimesh(m.clone(), opts(SplitRule::Sah, 0)),
+        Err(Error::InvalidParameter(_))
+    ));
+    let mut mesh = Mesh::<Kdop18>::from_trimesh(m.clone(), BuildOptions::default()).unwrap();
+    assert!(matches!(
+        mesh.clone().with_ray_options(opts(SplitRule::Sah, 0)),
+        Err(Error::InvalidParameter(_))
+    ));
+    // A failed deformation changes nothing (geometry, both trees).
+    mesh.ray_bvh();
+    let before = mesh.bvh().nodes().to_vec();
+    let ray_before = mesh.ray_bvh().bounds();
+    assert!(mesh.set_vertices(&m.vertices()[1..]).is_err());
     let mut nan = m.vertices().to_vec();
     nan[3].x = f32::NAN;
-    assert!(t.refit(&nan).is_err());
-    assert_eq!(t.nodes(), &before[..]);
+    assert!(mesh.set_vertices(&nan).is_err());
+    assert_eq!(mesh.bvh().nodes(), &before[..]);
+    assert_eq!(mesh.ray_bvh().bounds(), ray_before);
+    assert_eq!(mesh.trimesh(), &m);
     let mut c = Collider::<Kdop18>::default();
     let bad = [
         Affine3A::from_translation(Vec3::new(f32::NAN, 0.0, 0.0)),
@@ -119,15 +137,55 @@ fn bad_input_is_an_error() {
     ];
     for p in bad {
         assert!(matches!(
-            c.all_pairs_with((&t, &m), &p, (&t, &m), edge_crosses),
+            c.all_pairs_with(&mesh, &p, &mesh, edge_crosses),
+            Err(Error::InvalidPose(_))
+        ));
+        assert!(matches!(
+            mesh.collide(&p, &mesh),
+            Err(Error::InvalidPose(_))
+        ));
+        assert!(matches!(
+            mesh.collide_first(&p, &mesh),
             Err(Error::InvalidPose(_))
         ));
     }
-    let other = torus(3.0, 1.0, 9, 6);
-    assert!(c
-        .all_pairs_with((&t, &other), &Affine3A::IDENTITY, (&t, &m), edge_crosses)
-        .is_err());
+    // The low-level tree refuses any mesh but its own: another mesh (even with as
+    // many vertices), or its own deformed and not refit; a clone is its own.
+    let mut t = Bvh::<Kdop18>::build(&m, BuildOptions::default()).unwrap();
+    let before = t.nodes().to_vec();
+    let ray = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.1, 0.2, -1.0));
+    for other in [torus(3.0, 1.0, 9, 6), torus(3.0, 1.1, 8, 6)] {
+        assert!(matches!(
+            t.cast_ray(&other, &ray),
+            Err(Error::MeshMismatch(_))
+        ));
+        assert!(t.intersects_ray(&other, &ray).is_err());
+        assert!(t.validate(&other).is_err());
+        assert!(RayBvh::from_bvh(&t, &other).is_err());
+        assert!(matches!(t.refit(&other), Err(Error::MeshMismatch(_))));
+        assert_eq!(t.nodes(), &before[..]);
+    }
+    assert!(t.cast_ray(&m.clone(), &ray).is_ok());
+    let mut moved = m.clone();
+    let v: Vec<Vec3> = m.vertices().iter().map(|&p| p * 1.5).collect();
+    moved.set_vertices(&v).unwrap();
+    assert!(matches!(
+        t.cast_ray(&moved, &ray),
+        Err(Error::MeshMismatch(_))
+    ));
+    assert!(t.cast_ray(&m, &ray).is_ok());
+    t.refit(&moved).unwrap();
+    t.validate(&moved).unwrap();
+    assert!(t.cast_ray(&m, &ray).is_err());
+    assert!(t.cast_ray(&moved, &ray).is_ok());
     assert!(t.cast_ray(&m, &Ray::new(Vec3::ZERO, Vec3::ZERO)).is_err());
+    assert!(mesh.cast_ray(&Ray::new(Vec3::ZERO, Vec3::ZERO)).is_err());
+    assert!(mesh
+        .intersects_ray(&Ray::with_max_t(Vec3::ZERO, Vec3::X, -1.0))
+        .is_err());
+    assert!(mesh
+        .cast_segment(&Segment::new(Vec3::ONE, Vec3::ONE))
+        .is_err());
 }
 
 /// The culling of every BV type, split rule, rotation update and leaf size keeps
@@ -137,10 +195,15 @@ fn traversal_matches_brute<BV: BoundingVolume>(seed: u64, poses: usize) {
     let a = torus(2.0, 0.6, 18, 10);
     let b = terrain(4.0, 14, seed);
     let mut rng = Pcg64::seed_from_u64(seed);
-    let trees: Vec<(Bvh<BV>, Bvh<BV>)> = SPLITS
+    let meshes: Vec<(Mesh<BV>, Mesh<BV>)> = SPLITS
         .iter()
         .flat_map(|&s| [1, 4].map(move |l| opts(s, l)))
-        .map(|o| (Bvh::build(&a, o).unwrap(), Bvh::build(&b, o).unwrap()))
+        .map(|o| {
+            (
+                Mesh::from_trimesh(a.clone(), o).unwrap(),
+                Mesh::from_trimesh(b.clone(), o).unwrap(),
+            )
+        })
         .collect();
     let mut total = 0;
     for k in 0..poses {
@@ -154,18 +217,16 @@ fn traversal_matches_brute<BV: BoundingVolume>(seed: u64, poses: usize) {
         }
         let want = brute_pairs(&a, &pose, &b, edge_crosses);
         total += want.len();
-        for (ta, tb) in &trees {
+        for (ma, mb) in &meshes {
             for rot in [RotationUpdate::Refit, RotationUpdate::Conservative] {
                 let mut c = Collider::<BV>::new(rot);
-                let got = c
-                    .all_pairs_with((ta, &a), &pose, (tb, &b), edge_crosses)
-                    .unwrap();
+                let got = c.all_pairs_with(ma, &pose, mb, edge_crosses).unwrap();
                 assert_eq!(
                     sorted(got.pairs.clone()),
                     want,
                     "{} {:?} pose {k}",
                     BV::NAME,
-                    ta.options()
+                    ma.bvh().options()
                 );
                 assert!(got.counters.np >= want.len() as u64);
                 assert!(got.counters.np <= (a.len() * b.len()) as u64);
@@ -247,7 +308,7 @@ fn rays_match_brute<BV: BoundingVolume>(m: &TriMesh, seed: u64) {
                 let on_tri = p * (1.0 - h.u - h.v) + q * h.u + r * h.v;
                 assert!((on_tri - ray.at(h.t)).length() < 1e-3);
             }
-            assert_eq!(t.ray_hits_any(m, &ray).unwrap().is_some(), want.is_some());
+            assert_eq!(t.intersects_ray(m, &ray).unwrap(), want.is_some());
             if max_t == 1.0 {
                 let s = Segment::new(o, target);
                 assert_eq!(
@@ -280,15 +341,19 @@ fn ray_casts_match_brute_force() {
     }
 }
 
-/// Deform, refit, and check structure, rays and collisions against brute force.
+/// Deform (through the mesh, which refits both its trees), and check structure,
+/// rays and collisions against brute force.
 fn refit_after_deformation<BV: BoundingVolume>(seed: u64) {
     let mut rng = Pcg64::seed_from_u64(seed);
-    let mut a = torus(2.0, 0.6, 16, 10);
+    let a = torus(2.0, 0.6, 16, 10);
     let b = terrain(4.0, 12, seed);
-    let tb = Bvh::<BV>::build(&b, BuildOptions::default()).unwrap();
-    let mut ta = Bvh::<BV>::build(&a, opts(SplitRule::Sah, 2)).unwrap();
+    let mb = Mesh::<BV>::from_trimesh(b.clone(), BuildOptions::default()).unwrap();
+    let mut ma = Mesh::<BV>::from_trimesh(a, opts(SplitRule::Sah, 2)).unwrap();
+    // Built now, so every step refits it.
+    ma.ray_bvh();
     for step in 0..8 {
-        let v: Vec<Vec3> = a
+        let v: Vec<Vec3> = ma
+            .trimesh()
             .vertices()
             .iter()
             .map(|&p| {
@@ -296,9 +361,10 @@ fn refit_after_deformation<BV: BoundingVolume>(seed: u64) {
                     + Vec3::new(0.0, 0.0, rng.gen_range(-0.1..0.1))
             })
             .collect();
-        a.set_vertices(&v).unwrap();
-        ta.refit(a.vertices()).unwrap();
-        ta.validate(a.vertices()).unwrap();
+        ma.set_vertices(&v).unwrap();
+        let a = ma.trimesh();
+        assert_eq!(a.vertices(), &v[..]);
+        ma.bvh().validate(a).unwrap();
         let mut c = Collider::<BV>::default();
         for _ in 0..5 {
             let pose = random_pose(
@@ -306,17 +372,26 @@ fn refit_after_deformation<BV: BoundingVolume>(seed: u64) {
                 Vec3::new(-2.0, -2.0, -0.5),
                 Vec3::new(2.0, 2.0, 0.5),
             );
-            let want = brute_pairs(&a, &pose, &b, edge_crosses);
-            let got = c
-                .all_pairs_with((&ta, &a), &pose, (&tb, &b), edge_crosses)
-                .unwrap();
+            let want = brute_pairs(a, &pose, &b, edge_crosses);
+            let got = c.all_pairs_with(&ma, &pose, &mb, edge_crosses).unwrap();
             assert_eq!(sorted(got.pairs), want);
         }
         let ray = Ray::new(Vec3::new(5.0, 0.3, 0.2), Vec3::new(-1.0, 0.01, 0.0));
+        let want = brute_ray(a, &ray);
         assert_eq!(
-            ta.cast_ray(&a, &ray).unwrap().map(|h| (h.triangle, h.t)),
-            brute_ray(&a, &ray)
+            ma.bvh()
+                .cast_ray(a, &ray)
+                .unwrap()
+                .map(|h| (h.triangle, h.t)),
+            want
         );
+        assert_eq!(ma.cast_ray(&ray).unwrap().map(|h| (h.triangle, h.t)), want);
+        // The bounds follow the vertices.
+        let s = ma.bounding_sphere();
+        for p in &v {
+            assert!(ma.aabb().contains_point(*p));
+            assert!(p.as_dvec3().distance(s.center.as_dvec3()) <= s.radius as f64);
+        }
     }
 }
 
@@ -333,31 +408,41 @@ fn refit_every_bv() {
 /// Exact collision (all pairs and first contact) against brute force with
 /// `triangles_intersect`, for every BV type, split rule and rotation update.
 fn exact_matches_brute<BV: BoundingVolume>(a: &TriMesh, b: &TriMesh, poses: &[Affine3A]) -> usize {
-    let trees: Vec<(Bvh<BV>, Bvh<BV>)> = SPLITS
+    let meshes: Vec<(Mesh<BV>, Mesh<BV>)> = SPLITS
         .iter()
         .flat_map(|&s| [1, 3].map(move |l| opts(s, l)))
-        .map(|o| (Bvh::build(a, o).unwrap(), Bvh::build(b, o).unwrap()))
+        .map(|o| {
+            (
+                Mesh::from_trimesh(a.clone(), o).unwrap(),
+                Mesh::from_trimesh(b.clone(), o).unwrap(),
+            )
+        })
         .collect();
     let mut nonempty = 0;
     for (k, pose) in poses.iter().enumerate() {
         let want = brute_pairs(a, pose, b, triangles_intersect);
         nonempty += !want.is_empty() as usize;
-        for (ta, tb) in &trees {
+        for (ma, mb) in &meshes {
+            // The one-shot forms are the collider's with `RotationUpdate::Auto`.
+            let once = ma.collide(pose, mb).unwrap();
+            assert_eq!(sorted(once.pairs), want, "{} collide pose {k}", BV::NAME);
+            let once = ma.collide_first(pose, mb).unwrap();
+            assert_eq!(once.pair.is_some(), !want.is_empty());
             for rot in [
                 RotationUpdate::Refit,
                 RotationUpdate::Conservative,
                 RotationUpdate::Auto,
             ] {
                 let mut c = Collider::<BV>::new(rot);
-                let got = c.all_pairs((ta, a), pose, (tb, b)).unwrap();
+                let got = c.all_pairs(ma, pose, mb).unwrap();
                 assert_eq!(
                     sorted(got.pairs),
                     want,
                     "{} {:?} {rot:?} pose {k}",
                     BV::NAME,
-                    ta.options()
+                    ma.bvh().options()
                 );
-                let first = c.first_contact((ta, a), pose, (tb, b)).unwrap();
+                let first = c.first_contact(ma, pose, mb).unwrap();
                 assert_eq!(first.pair.is_some(), !want.is_empty());
                 if let Some(p) = first.pair {
                     assert!(want.binary_search(&p).is_ok());
@@ -421,4 +506,52 @@ fn exact_collision_touching_and_coplanar() {
         Affine3A::from_translation(Vec3::new(1.9, 0.1, 0.0)),
     ];
     exact_every_bv(&s, &s, &poses);
+}
+
+/// A mesh at the identity touches itself (every triangle meets itself, closed),
+/// whatever its scale: near `f32::MAX`, tiny, degenerate (points and segments).
+/// Its bounds contain it, and its ray cast agrees with brute force.
+#[test]
+fn meshes_of_every_scale_touch_themselves() {
+    let big = f32::MAX / 4.0;
+    let cases = [
+        vec![
+            Vec3::splat(-big),
+            Vec3::new(big, 0.0, 0.0),
+            Vec3::new(0.0, big, big),
+        ],
+        vec![Vec3::splat(1e30), Vec3::new(-1e30, 1.0, 0.0), Vec3::Z],
+        vec![
+            Vec3::splat(1e-30),
+            Vec3::new(2e-30, 0.0, 0.0),
+            Vec3::new(0.0, 1e-38, 0.0),
+        ],
+        // Degenerate: a point and a segment.
+        vec![Vec3::ONE, Vec3::ONE, Vec3::ONE],
+        vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
+    ];
+    for (k, v) in cases.iter().enumerate() {
+        let tris = vec![[0, 1, 2], [2, 1, 0], [1, 1, 2]];
+        let m = TriMesh::new(v.clone(), tris).unwrap();
+        let mesh = Mesh::<Kdop18>::from_trimesh(m.clone(), BuildOptions::default()).unwrap();
+        mesh.bvh().validate(mesh.trimesh()).unwrap();
+        let want = brute_pairs(&m, &Affine3A::IDENTITY, &m, triangles_intersect);
+        assert!((0..3).all(|i| want.contains(&(i, i))), "case {k}");
+        let got = mesh.collide(&Affine3A::IDENTITY, &mesh).unwrap();
+        assert_eq!(sorted(got.pairs), want, "case {k}");
+        assert!(mesh
+            .collide_first(&Affine3A::IDENTITY, &mesh)
+            .unwrap()
+            .pair
+            .is_some());
+        let s = mesh.bounding_sphere();
+        for p in v {
+            assert!(mesh.aabb().contains_point(*p), "case {k}");
+            assert!(p.as_dvec3().distance(s.center.as_dvec3()) <= s.radius as f64);
+        }
+        let c = mesh.aabb().center();
+        let ray = Ray::new(c + Vec3::new(0.3, 0.2, 1.0), Vec3::new(-0.3, -0.2, -1.0));
+        let hit = mesh.cast_ray(&ray).unwrap().map(|h| (h.triangle, h.t));
+        assert_eq!(hit, brute_ray(&m, &ray), "case {k}");
+    }
 }

@@ -2,15 +2,16 @@
 //! `ray_triangle`: random rays from outside and inside, rays aimed exactly at
 //! vertices and edge points, axis-parallel rays, rays in a triangle's plane,
 //! bounded rays; for [`RayBvh`] (every split rule and leaf size, and the k-DOP
-//! topology) and for `Bvh<BV>` with every volume.
+//! topology), for `Bvh<BV>` with every volume, and for [`Mesh`] (its own ray tree).
 
 use super::meshes::{torus, uv_sphere};
 use proxima::geom::{Aabb, Ray, Segment, Sphere};
 use proxima::glam::Vec3;
 use proxima::narrow::{
-    ray_triangle, BoundingVolume, BuildOptions, Bvh, Kdop14, Kdop18, Kdop26, Obb, RayBvh,
-    SplitRule, TriMesh,
+    ray_triangle, BoundingVolume, BuildOptions, Bvh, Kdop14, Kdop18, Kdop26, Mesh, Obb, RayBvh,
+    SplitRule, TriMesh, TriangleHit,
 };
+use proxima::Result;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -122,7 +123,37 @@ fn ray_mix(m: &TriMesh, n: usize, seed: u64) -> Vec<Ray> {
     out
 }
 
-fn check_ray_bvh(m: &TriMesh, t: &RayBvh, rays: &[Ray], wants: &[Option<(u32, f32)>], what: &str) {
+/// A structure that owns its triangles: its closest-hit and any-hit casts.
+trait Caster {
+    fn cast_ray(&self, ray: &Ray) -> Result<Option<TriangleHit>>;
+    fn intersects_ray(&self, ray: &Ray) -> Result<bool>;
+}
+
+impl Caster for RayBvh {
+    fn cast_ray(&self, ray: &Ray) -> Result<Option<TriangleHit>> {
+        RayBvh::cast_ray(self, ray)
+    }
+    fn intersects_ray(&self, ray: &Ray) -> Result<bool> {
+        RayBvh::intersects_ray(self, ray)
+    }
+}
+
+impl<BV: BoundingVolume> Caster for Mesh<BV> {
+    fn cast_ray(&self, ray: &Ray) -> Result<Option<TriangleHit>> {
+        Mesh::cast_ray(self, ray)
+    }
+    fn intersects_ray(&self, ray: &Ray) -> Result<bool> {
+        Mesh::intersects_ray(self, ray)
+    }
+}
+
+fn check_ray_bvh(
+    m: &TriMesh,
+    t: &impl Caster,
+    rays: &[Ray],
+    wants: &[Option<(u32, f32)>],
+    what: &str,
+) {
     for (k, (ray, want)) in rays.iter().zip(wants).enumerate() {
         let got = t.cast_ray(ray).unwrap();
         assert_eq!(
@@ -140,7 +171,7 @@ fn check_ray_bvh(m: &TriMesh, t: &RayBvh, rays: &[Ray], wants: &[Option<(u32, f3
             );
         }
         assert_eq!(
-            t.ray_hits_any(ray).unwrap().is_some(),
+            t.intersects_ray(ray).unwrap(),
             want.is_some(),
             "{what} any ray {k}"
         );
@@ -174,6 +205,16 @@ fn check_mesh(m: &TriMesh, n: usize, seed: u64) {
     let k = Bvh::<Kdop18>::build(m, BuildOptions::default()).unwrap();
     let t = RayBvh::from_bvh(&k, m).unwrap();
     check_ray_bvh(m, &t, &rays, &wants, "RayBvh from k-DOP");
+    let mesh = Mesh::<Kdop18>::from_trimesh(m.clone(), BuildOptions::default()).unwrap();
+    check_ray_bvh(m, &mesh, &rays, &wants, "Mesh");
+    let mesh = Mesh::<Obb>::from_trimesh(m.clone(), BuildOptions::default())
+        .unwrap()
+        .with_ray_options(BuildOptions {
+            split: SplitRule::Median,
+            leaf_size: 2,
+        })
+        .unwrap();
+    check_ray_bvh(m, &mesh, &rays, &wants, "Mesh, median ray tree");
     check_bvh::<Aabb>(m, &rays, &wants);
     check_bvh::<Kdop14>(m, &rays, &wants);
     check_bvh::<Kdop18>(m, &rays, &wants);
@@ -326,6 +367,7 @@ fn parallel_batches_equal_sequential_casts() {
     let rays = ray_mix(&m, 3000, 11);
     let t = RayBvh::build(&m, BuildOptions::default()).unwrap();
     let b = Bvh::<Kdop18>::build(&m, BuildOptions::default()).unwrap();
+    let mesh = Mesh::<Kdop18>::from_trimesh(m.clone(), BuildOptions::default()).unwrap();
     let seq: Vec<_> = rays.iter().map(|r| t.cast_ray(r).unwrap()).collect();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
@@ -334,9 +376,15 @@ fn parallel_batches_equal_sequential_casts() {
     pool.install(|| {
         assert_eq!(t.cast_rays_par(&rays).unwrap(), seq);
         assert_eq!(b.cast_rays_par(&m, &rays).unwrap(), seq);
+        assert_eq!(mesh.cast_rays_par(&rays).unwrap(), seq);
     });
     let mut bad = rays.clone();
     bad[1234].dir = Vec3::ZERO;
     assert!(t.cast_rays_par(&bad).is_err());
     assert!(b.cast_rays_par(&m, &bad).is_err());
+    assert!(mesh.cast_rays_par(&bad).is_err());
+    // A mesh of the same content built apart is another mesh to the tree.
+    let apart = TriMesh::new(m.vertices().to_vec(), m.triangles().to_vec()).unwrap();
+    assert!(b.cast_rays_par(&apart, &rays).is_err());
+    assert!(b.cast_rays_par(mesh.trimesh(), &rays).is_ok());
 }

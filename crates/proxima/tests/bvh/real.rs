@@ -4,8 +4,8 @@ use super::meshes::random_pose;
 use proxima::geom::{Aabb, Ray, Sphere};
 use proxima::glam::{Affine3A, Vec3};
 use proxima::narrow::{
-    triangles_intersect, BoundingVolume, BuildOptions, Bvh, Collider, Kdop14, Kdop18, Kdop26, Obb,
-    RotationUpdate, SplitRule, TriMesh,
+    triangles_intersect, BoundingVolume, BuildOptions, Bvh, Collider, Kdop14, Kdop18, Kdop26, Mesh,
+    Obb, RotationUpdate, SplitRule, TriMesh,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -49,17 +49,17 @@ fn check<BV: BoundingVolume>(
             split,
             leaf_size: 1 + (split == SplitRule::Sah) as usize * 3,
         };
-        let (ta, tb) = (
-            Bvh::<BV>::build(a, o).unwrap(),
-            Bvh::<BV>::build(b, o).unwrap(),
+        let (ma, mb) = (
+            Mesh::<BV>::from_trimesh(a.clone(), o).unwrap(),
+            Mesh::<BV>::from_trimesh(b.clone(), o).unwrap(),
         );
         for rot in [RotationUpdate::Refit, RotationUpdate::Conservative] {
             let mut c = Collider::<BV>::new(rot);
             for (k, (pose, want)) in poses.iter().zip(wants).enumerate() {
-                let mut got = c.all_pairs((&ta, a), pose, (&tb, b)).unwrap().pairs;
+                let mut got = c.all_pairs(&ma, pose, &mb).unwrap().pairs;
                 got.sort_unstable();
                 assert_eq!(&got, want, "{} {split:?} {rot:?} pose {k}", BV::NAME);
-                let f = c.first_contact((&ta, a), pose, (&tb, b)).unwrap();
+                let f = c.first_contact(&ma, pose, &mb).unwrap();
                 assert_eq!(f.pair.is_some(), !want.is_empty(), "{} pose {k}", BV::NAME);
             }
         }
@@ -150,6 +150,7 @@ fn rays_on_bunny_match_brute_force() {
         },
     )
     .unwrap();
+    let mesh = Mesh::<Kdop18>::from_trimesh(bunny.clone(), BuildOptions::default()).unwrap();
     let (lo, hi) = bunny
         .vertices()
         .iter()
@@ -182,6 +183,10 @@ fn rays_on_bunny_match_brute_force() {
         );
         assert_eq!(
             o.cast_ray(&bunny, &ray).unwrap().map(|h| (h.triangle, h.t)),
+            want
+        );
+        assert_eq!(
+            mesh.cast_ray(&ray).unwrap().map(|h| (h.triangle, h.t)),
             want
         );
     }

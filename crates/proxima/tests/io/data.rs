@@ -58,4 +58,40 @@ fn missing_file_is_an_io_error() {
         load(path("no_such.obj")),
         Err(proxima::Error::Io { .. })
     ));
+    // The operating system's error is kept as the source.
+    let e = load(path("no_such.obj")).unwrap_err();
+    let src = std::error::Error::source(&e).expect("source");
+    let io = src.downcast_ref::<std::io::Error>().expect("an io::Error");
+    assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
+    assert!(e.to_string().contains("no_such.obj"), "{e}");
+    assert_eq!(e, load(path("no_such.obj")).unwrap_err());
+}
+
+#[test]
+fn unknown_format_has_its_own_error() {
+    let file = std::env::temp_dir().join(format!("proxima-unknown-{}.xyz", std::process::id()));
+    std::fs::write(&file, b"neither a mesh nor anything else\n").unwrap();
+    let e = load(&file).unwrap_err();
+    let _ = std::fs::remove_file(&file);
+    match &e {
+        proxima::Error::UnknownFormat { file: f } => assert!(f.ends_with(".xyz"), "{f}"),
+        other => panic!("expected UnknownFormat, got {other:?}"),
+    }
+    assert!(e.to_string().contains("unknown mesh format"), "{e}");
+    assert_eq!(e.to_string().lines().count(), 1);
+}
+
+#[test]
+fn a_mesh_loads_with_its_trees_in_one_call() {
+    use proxima::narrow::{Kdop18, Mesh, Obb};
+    let m = Mesh::<Kdop18>::load(path("bunny.obj")).unwrap();
+    assert_eq!(m.trimesh().len(), 3674);
+    assert_eq!(m.trimesh(), &load(path("bunny.obj")).unwrap());
+    m.bvh().validate(m.trimesh()).unwrap();
+    let m = Mesh::<Obb>::load(path("forearm.stl")).unwrap();
+    assert_eq!(m.trimesh().len(), 1000);
+    assert!(matches!(
+        Mesh::<Kdop18>::load(path("no_such.obj")),
+        Err(proxima::Error::Io { .. })
+    ));
 }

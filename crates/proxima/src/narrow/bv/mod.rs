@@ -1,23 +1,6 @@
-//! Bounding volumes for mesh BVHs, behind one trait [sources: bv-kinds, bvh-cost].
-//!
-//! The source compares spheres, AABBs, OBBs and k-DOPs through the cost model
-//! `T = Nv*Cv + Np*Cp + Nu*Cu`: a tighter volume lowers `Nv` (volume tests) and `Np`
-//! (triangle tests), a cheaper one lowers `Cv`, and one that is cheap to update under
-//! motion lowers `Nu*Cu`. Every volume here implements [`BoundingVolume`], so a
-//! [`Bvh`](crate::narrow::Bvh) and the collision queries are written once.
-//!
-//! Two families:
-//! - *axis-aligned* volumes ([`Aabb`](crate::geom::Aabb), [`Kdop`]): their slab
-//!   normals are fixed in the world. A translation shifts the slab intervals (no node
-//!   update); a rotation needs the moving tree refit ([`BoundingVolume::AXIS_ALIGNED`]).
-//! - *oriented* volumes ([`Obb`], [`Sphere`](crate::geom::Sphere)): the test takes
-//!   the relative pose directly.
-//!
-//! Robustness: volumes are fitted from `f32` points, and the triangle test receives
-//! `f32` points transformed by the pose, so every overlap test accepts an absolute
-//! `slack` that covers the rounding of projections, transforms and shifts (computed
-//! per query from the coordinate magnitudes). The tests are therefore conservative:
-//! they never reject a pair whose triangles intersect.
+//! Bounding volumes for mesh BVHs behind one trait, [`BoundingVolume`] [sources: bv-kinds, bvh-cost]:
+//! its impls for [`Aabb`](crate::geom::Aabb) and [`Sphere`](crate::geom::Sphere),
+//! and the [`Kdop`] and [`Obb`] types, one file each.
 
 mod aabb;
 mod kdop;
@@ -32,6 +15,25 @@ use glam::{Affine3A, Vec3};
 use std::fmt::Debug;
 
 /// A bounding volume usable in a [`Bvh`](crate::narrow::Bvh).
+///
+/// The seed compares spheres, AABBs, OBBs and k-DOPs through the cost model
+/// `T = Nv*Cv + Np*Cp + Nu*Cu`: a tighter volume lowers `Nv` (volume tests) and `Np`
+/// (triangle tests), a cheaper one lowers `Cv`, and one that is cheap to update under
+/// motion lowers `Nu*Cu`. Every volume implements this trait, so a
+/// [`Bvh`](crate::narrow::Bvh) and the collision queries are written once.
+///
+/// Two families:
+/// - *axis-aligned* volumes ([`Aabb`](crate::geom::Aabb), [`Kdop`]): their slab
+///   normals are fixed in the world. A translation shifts the slab intervals (no node
+///   update); a rotation needs the moving tree refit ([`BoundingVolume::AXIS_ALIGNED`]).
+/// - *oriented* volumes ([`Obb`], [`Sphere`](crate::geom::Sphere)): the test takes
+///   the relative pose directly.
+///
+/// Robustness: volumes are fitted from `f32` points, and the triangle test receives
+/// `f32` points transformed by the pose, so every overlap test accepts an absolute
+/// `slack` that covers the rounding of projections, transforms and shifts (computed
+/// per query from the coordinate magnitudes). The tests are therefore conservative:
+/// they never reject a pair whose triangles intersect.
 ///
 /// "Moving frame" below is the frame of the mesh that carries a pose (the first
 /// mesh of a collision query); the pose maps it into the frame of the other mesh.

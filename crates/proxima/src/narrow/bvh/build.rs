@@ -1,49 +1,12 @@
 //! Top-down binary build [sources: bvh-build].
 
+use super::options::{BuildOptions, SplitRule};
 use super::tree::{coord_bound, Bvh, Node};
 use crate::geom::Aabb;
 use crate::narrow::bv::BoundingVolume;
 use crate::narrow::TriMesh;
-use crate::{Error, Result};
+use crate::Result;
 use glam::Vec3;
-
-/// How a node's triangles are split in two.
-///
-/// The source [sources: bvh-build] splits "by a plane orthogonal to one of the three
-/// coordinate axes through the mean or the median of the centroid coordinates"; the
-/// axis here is the one along which the centroids spread most.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum SplitRule {
-    /// Plane through the mean centroid coordinate (falls back to the median when one
-    /// side would be empty). Adapts to clusters; depth is not bounded by `log n`.
-    Mean,
-    /// Plane through the median: a balanced tree of depth `⌈log2(n / leaf)⌉ + 1`.
-    Median,
-    /// Binned surface-area heuristic (16 bins on each axis, AABB areas): the plane
-    /// minimizing `area(L)·|L| + area(R)·|R|`. Not in [sources: bvh-build]; the default, since
-    /// its trees need 35–45 % fewer volume tests than the median's on W5.
-    #[default]
-    Sah,
-}
-
-/// Parameters of [`Bvh::build`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BuildOptions {
-    /// Split rule.
-    pub split: SplitRule,
-    /// Maximum number of triangles in a leaf (`>= 1`).
-    pub leaf_size: usize,
-}
-
-impl Default for BuildOptions {
-    /// SAH split, one triangle per leaf (FCL's leaf size).
-    fn default() -> Self {
-        BuildOptions {
-            split: SplitRule::Sah,
-            leaf_size: 1,
-        }
-    }
-}
 
 const BINS: usize = 16;
 
@@ -53,11 +16,15 @@ impl<BV: BoundingVolume> Bvh<BV> {
     /// `options.split`. O(n log n) for the median and SAH rules (each level fits
     /// every triangle once); the mean rule may build deeper trees on clustered input.
     ///
-    /// Fails on `leaf_size == 0`.
+    /// Fails with [`Error::InvalidParameter`](crate::Error::InvalidParameter) on
+    /// `leaf_size == 0`.
     pub fn build(mesh: &TriMesh, options: BuildOptions) -> Result<Bvh<BV>> {
-        if options.leaf_size == 0 {
-            return Err(Error::Invalid("BVH leaf size must be at least 1".into()));
-        }
+        options.check()?;
+        Ok(Bvh::build_valid(mesh, options))
+    }
+
+    /// [`Bvh::build`] with options already checked.
+    pub(crate) fn build_valid(mesh: &TriMesh, options: BuildOptions) -> Bvh<BV> {
         let n = mesh.len();
         let centroids: Vec<Vec3> = (0..n)
             .map(|i| {
@@ -101,14 +68,14 @@ impl<BV: BoundingVolume> Bvh<BV> {
             .iter()
             .map(|&t| mesh.triangles()[t as usize])
             .collect();
-        Ok(Bvh {
+        Bvh {
             nodes,
             tris,
             ids: order,
-            n_vertices: mesh.vertices().len(),
+            mesh: mesh.stamp(),
             coord_bound: coord_bound(mesh.vertices()),
             options,
-        })
+        }
     }
 }
 

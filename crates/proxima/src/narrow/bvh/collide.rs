@@ -1,11 +1,12 @@
-//! Collision of two posed meshes: simultaneous traversal of their BVHs down to exact
-//! triangle–triangle tests, with the cost counters of [sources: bvh-cost].
+//! Collision of two posed meshes ([`Mesh::collide`], [`Collider`]): simultaneous
+//! traversal of their BVHs down to exact triangle–triangle tests, with the cost
+//! counters of [sources: bvh-cost].
 
+use super::mesh::Mesh;
 use super::traverse::{traverse, Lazy, Local, Precomputed};
-use super::tree::Bvh;
 use super::tri_cache::{QueryCache, TriangleCache};
 use crate::narrow::bv::{slack_for, BoundingVolume};
-use crate::narrow::{PreparedTriangle, TriMesh};
+use crate::narrow::PreparedTriangle;
 use crate::{Error, Result};
 use glam::{Affine3A, Mat3A, Vec3};
 
@@ -67,7 +68,8 @@ pub struct FirstContact {
 }
 
 /// Reusable scratch space and settings for mesh–mesh queries (no allocation per
-/// query once warmed up).
+/// query once warmed up): the form of [`Mesh::collide`] for a loop of queries.
+/// One collider serves any meshes, one query at a time.
 #[derive(Clone, Debug)]
 pub struct Collider<BV> {
     /// How axis-aligned volumes follow rotations.
@@ -88,24 +90,20 @@ impl<BV: BoundingVolume> Default for Collider<BV> {
     }
 }
 
-/// All intersecting triangle pairs of `a` moved by `pose` and `b` (at the identity).
-/// See [`Collider::all_pairs`].
-pub fn collide_all<BV: BoundingVolume>(
-    a: (&Bvh<BV>, &TriMesh),
-    pose: &Affine3A,
-    b: (&Bvh<BV>, &TriMesh),
-) -> Result<Contacts> {
-    Collider::new(RotationUpdate::Auto).all_pairs(a, pose, b)
-}
+impl<BV: BoundingVolume> Mesh<BV> {
+    /// Every intersecting triangle pair of this mesh moved by `pose` and `other`
+    /// (at the identity): [`Collider::all_pairs`] with a new collider
+    /// ([`RotationUpdate::Auto`]), whose scratch space is allocated for this one
+    /// query; keep a [`Collider`] for repeated queries.
+    pub fn collide(&self, pose: &Affine3A, other: &Mesh<BV>) -> Result<Contacts> {
+        Collider::new(RotationUpdate::Auto).all_pairs(self, pose, other)
+    }
 
-/// Whether `a` moved by `pose` and `b` intersect (early exit). See
-/// [`Collider::first_contact`].
-pub fn collide_first<BV: BoundingVolume>(
-    a: (&Bvh<BV>, &TriMesh),
-    pose: &Affine3A,
-    b: (&Bvh<BV>, &TriMesh),
-) -> Result<FirstContact> {
-    Collider::new(RotationUpdate::Auto).first_contact(a, pose, b)
+    /// Whether this mesh moved by `pose` and `other` intersect, with an early exit:
+    /// [`Collider::first_contact`] with a new collider (see [`Mesh::collide`]).
+    pub fn collide_first(&self, pose: &Affine3A, other: &Mesh<BV>) -> Result<FirstContact> {
+        Collider::new(RotationUpdate::Auto).first_contact(self, pose, other)
+    }
 }
 
 /// Checks that `pose` is a rigid motion as the collision queries need it: finite,
@@ -163,14 +161,9 @@ impl<BV: BoundingVolume> Collider<BV> {
     /// or one update per visited node (conservative). A pure translation moves k-DOPs
     /// by shifting their intervals, at no update cost.
     ///
-    /// Fails on a pose that is not a rigid motion, or a mesh whose vertex count
-    /// differs from its BVH's.
-    pub fn all_pairs(
-        &mut self,
-        a: (&Bvh<BV>, &TriMesh),
-        pose: &Affine3A,
-        b: (&Bvh<BV>, &TriMesh),
-    ) -> Result<Contacts> {
+    /// Fails with [`Error::InvalidPose`] on a pose that is not a rigid motion
+    /// ([`check_pose`]).
+    pub fn all_pairs(&mut self, a: &Mesh<BV>, pose: &Affine3A, b: &Mesh<BV>) -> Result<Contacts> {
         let mut pairs = Vec::new();
         let counters = self.run(a, pose, b, false, &mut pairs, None)?;
         Ok(Contacts { pairs, counters })
@@ -183,9 +176,9 @@ impl<BV: BoundingVolume> Collider<BV> {
     /// volumes guarantee.
     pub fn all_pairs_with(
         &mut self,
-        a: (&Bvh<BV>, &TriMesh),
+        a: &Mesh<BV>,
         pose: &Affine3A,
-        b: (&Bvh<BV>, &TriMesh),
+        b: &Mesh<BV>,
         triangle_test: impl Fn(&[Vec3; 3], &[Vec3; 3]) -> bool,
     ) -> Result<Contacts> {
         let mut pairs = Vec::new();
@@ -196,9 +189,9 @@ impl<BV: BoundingVolume> Collider<BV> {
     /// Like [`Collider::all_pairs`] but stops at the first intersecting pair.
     pub fn first_contact(
         &mut self,
-        a: (&Bvh<BV>, &TriMesh),
+        a: &Mesh<BV>,
         pose: &Affine3A,
-        b: (&Bvh<BV>, &TriMesh),
+        b: &Mesh<BV>,
     ) -> Result<FirstContact> {
         let mut pairs = Vec::new();
         let counters = self.run(a, pose, b, true, &mut pairs, None)?;
@@ -210,16 +203,17 @@ impl<BV: BoundingVolume> Collider<BV> {
 
     fn run(
         &mut self,
-        (ta, ma): (&Bvh<BV>, &TriMesh),
+        a: &Mesh<BV>,
         pose: &Affine3A,
-        (tb, mb): (&Bvh<BV>, &TriMesh),
+        b: &Mesh<BV>,
         first: bool,
         out: &mut Vec<(u32, u32)>,
         custom: Option<&TriangleTest>,
     ) -> Result<CostCounters> {
         let dev = pose_deviation(pose)?;
-        ta.check_vertices(ma.vertices().len())?;
-        tb.check_vertices(mb.vertices().len())?;
+        // A mesh's tree always matches its geometry: nothing else to check.
+        let (ta, ma) = (a.bvh(), a.trimesh());
+        let (tb, mb) = (b.bvh(), b.trimesh());
         let t1 = glam::Vec3::from(pose.translation).abs().element_sum();
         let scale = 2.0 * (1.8 * ta.coord_bound * (1.0 + dev) + t1 + tb.coord_bound);
         let slack = slack_for(scale, dev);

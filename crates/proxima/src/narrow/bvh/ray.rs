@@ -1,36 +1,13 @@
-//! Ray and segment casts against a mesh BVH.
+//! Ray and segment casts against a mesh [`Bvh`] of any bounding volume.
 
-use super::ray_cast::Stack;
+use super::stack::Stack;
 use super::tree::Bvh;
 use crate::geom::{Ray, Segment};
 use crate::narrow::bv::{slack_for, BoundingVolume};
-use crate::narrow::ray_triangle::{prepare_triangle, RayFilter, WoopRay};
+use crate::narrow::ray_triangle::{prepare_triangle, RayFilter, TriangleHit, WoopRay};
 use crate::narrow::TriMesh;
 use crate::Result;
 use glam::Vec3A;
-
-/// The closest hit of a ray on a mesh.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RayHit {
-    /// Index of the triangle in the mesh.
-    pub triangle: u32,
-    /// Ray parameter of the hit (units of `ray.dir`; for a segment, 0 at `a`, 1 at `b`).
-    pub t: f32,
-    /// Barycentric weight of the triangle's second corner.
-    pub u: f32,
-    /// Barycentric weight of the third corner (the hit is `(1-u-v)a + u b + v c`).
-    pub v: f32,
-}
-
-/// The mesh casts' ordering of hits: `(t, triangle)` of a new hit comes before
-/// `best` if it is nearer, or as near with a smaller triangle index. Both mesh
-/// casts ([`Bvh::cast_ray`], [`RayBvh`](crate::narrow::RayBvh)) keep the first hit
-/// in this order (as the tests' brute force does), so their answers never depend
-/// on the order in which triangles are tested.
-#[inline(always)]
-pub(crate) fn closer(t: f32, triangle: u32, best: Option<RayHit>) -> bool {
-    best.map_or(true, |b| t < b.t || (t == b.t && triangle < b.triangle))
-}
 
 impl<BV: BoundingVolume> Bvh<BV> {
     /// The closest hit of `ray` on `mesh` (smallest `t`; ties go to the smaller
@@ -40,38 +17,40 @@ impl<BV: BoundingVolume> Bvh<BV> {
     /// the nearer child first and prunes nodes entered beyond the best hit: O(log n)
     /// typical. ([`RayBvh`](crate::narrow::RayBvh) gives the same answers faster.)
     ///
-    /// Fails on an invalid ray (non-finite, zero direction, negative `max_t`) or a
-    /// mesh whose vertex count differs from the tree's.
-    pub fn cast_ray(&self, mesh: &TriMesh, ray: &Ray) -> Result<Option<RayHit>> {
+    /// Fails on an invalid ray (non-finite, zero direction, negative or NaN
+    /// `max_t`), or with [`Error::MeshMismatch`](crate::Error::MeshMismatch) on a
+    /// mesh other than the tree's (see [`Bvh`]).
+    pub fn cast_ray(&self, mesh: &TriMesh, ray: &Ray) -> Result<Option<TriangleHit>> {
         self.cast(mesh, ray, false)
     }
 
-    /// Whether `ray` hits `mesh` at all (stops at the first hit found; the returned
-    /// hit is any hit, not necessarily the closest).
-    pub fn ray_hits_any(&self, mesh: &TriMesh, ray: &Ray) -> Result<Option<RayHit>> {
-        self.cast(mesh, ray, true)
+    /// Whether `ray` hits `mesh` at all: stops at the first hit found, which need
+    /// not be the closest. Fails as [`Bvh::cast_ray`] does.
+    pub fn intersects_ray(&self, mesh: &TriMesh, ray: &Ray) -> Result<bool> {
+        Ok(self.cast(mesh, ray, true)?.is_some())
     }
 
     /// [`Bvh::cast_ray`] for the segment from `seg.a` (`t = 0`) to `seg.b` (`t = 1`).
-    pub fn cast_segment(&self, mesh: &TriMesh, seg: &Segment) -> Result<Option<RayHit>> {
+    pub fn cast_segment(&self, mesh: &TriMesh, seg: &Segment) -> Result<Option<TriangleHit>> {
         self.cast(mesh, &seg.to_ray(), false)
     }
 
-    fn cast(&self, mesh: &TriMesh, ray: &Ray, any: bool) -> Result<Option<RayHit>> {
+    fn cast(&self, mesh: &TriMesh, ray: &Ray, any: bool) -> Result<Option<TriangleHit>> {
         ray.validate()?;
-        self.check_vertices(mesh.vertices().len())?;
+        self.check_mesh(mesh)?;
         Ok(self.cast_valid(mesh, ray, any))
     }
 
-    /// The cast of a validated ray on a mesh of the right size.
-    pub(crate) fn cast_valid(&self, mesh: &TriMesh, ray: &Ray, any: bool) -> Option<RayHit> {
+    /// The cast of a validated ray on the tree's own mesh (`any`: stop at the
+    /// first hit found).
+    pub(crate) fn cast_valid(&self, mesh: &TriMesh, ray: &Ray, any: bool) -> Option<TriangleHit> {
         let scale = 2.0 * (self.coord_bound + ray.origin.abs().element_sum());
         let slack = slack_for(scale, 0.0);
         let verts = mesh.vertices();
         let filter = RayFilter::new(ray);
         // The exact test's per-ray setup, on the first triangle that needs it.
         let mut woop: Option<WoopRay> = None;
-        let mut best: Option<RayHit> = None;
+        let mut best: Option<TriangleHit> = None;
         let mut limit = ray.max_t;
         let mut stack = Stack::new();
         if let Some(t) = self.nodes[0].bv.ray_entry(ray, slack) {
@@ -93,13 +72,8 @@ impl<BV: BoundingVolume> Bvh<BV> {
                     let w = woop.get_or_insert_with(|| WoopRay::new(ray));
                     if let Some(h) = w.hit(&tri) {
                         let id = self.ids[k];
-                        if closer(h.t, id, best) {
-                            best = Some(RayHit {
-                                triangle: id,
-                                t: h.t,
-                                u: h.u,
-                                v: h.v,
-                            });
+                        if h.precedes(id, &best) {
+                            best = Some(h.on(id));
                             if any {
                                 return best;
                             }

@@ -1,64 +1,16 @@
 //! Ray and segment casts against a [`RayBvh`].
 
-use super::ray::RayHit;
 use super::ray_tree::{RayBvh, RayNode, LEAF};
+use super::stack::Stack;
 use crate::geom::{Ray, Segment};
 use crate::narrow::bv::BoundingVolume;
-use crate::narrow::ray_triangle::{RayFilter, WoopRay};
+use crate::narrow::ray_triangle::{RayFilter, TriangleHit, WoopRay};
 use crate::Result;
 use glam::{Vec3, Vec3A, Vec4};
 
 /// Relative widening of the box entry and exit parameters: the subtraction, the
 /// rounded reciprocal and the product each round by at most ε/2.
 const WIDEN: f32 = 4.0 * f32::EPSILON;
-
-/// Slots of the traversal stack kept on the machine stack (deeper trees spill).
-const STACK: usize = 16;
-
-/// A LIFO of `(node, entry t)` on the machine stack, spilling to the heap only for
-/// trees deeper than [`STACK`]. Items are packed in a `u64` (node in the low half,
-/// the bits of `t` in the high half) so that creating the stack, once per ray,
-/// is a few vector stores rather than one store per field.
-pub(crate) struct Stack {
-    items: [u64; STACK],
-    len: usize,
-    spill: Vec<u64>,
-}
-
-impl Stack {
-    #[inline(always)]
-    pub(crate) fn new() -> Stack {
-        Stack {
-            items: [0; STACK],
-            len: 0,
-            spill: Vec::new(),
-        }
-    }
-
-    #[inline(always)]
-    pub(crate) fn push(&mut self, (i, t): (u32, f32)) {
-        let x = i as u64 | (t.to_bits() as u64) << 32;
-        if self.len < STACK {
-            self.items[self.len] = x;
-            self.len += 1;
-        } else {
-            self.spill.push(x);
-        }
-    }
-
-    #[inline(always)]
-    pub(crate) fn pop(&mut self) -> Option<(u32, f32)> {
-        let x = match self.spill.pop() {
-            Some(x) => x,
-            None if self.len == 0 => return None,
-            None => {
-                self.len -= 1;
-                self.items[self.len]
-            }
-        };
-        Some((x as u32, f32::from_bits((x >> 32) as u32)))
-    }
-}
 
 /// The ray in the form the 4-wide slab test wants: origin and inverse direction
 /// splatted per axis.
@@ -110,26 +62,27 @@ fn entry4_general(n: &RayNode, ray: &Ray, limit: f32) -> (Vec4, u32) {
 impl RayBvh {
     /// The closest hit of `ray` (smallest `t`, ties to the smaller triangle index):
     /// exactly [`Bvh::cast_ray`](crate::narrow::Bvh::cast_ray)'s answer, faster.
-    /// O(log n) typical. Fails on an invalid ray.
-    pub fn cast_ray(&self, ray: &Ray) -> Result<Option<RayHit>> {
+    /// O(log n) typical. Fails on an invalid ray (non-finite, zero direction,
+    /// negative or NaN `max_t`).
+    pub fn cast_ray(&self, ray: &Ray) -> Result<Option<TriangleHit>> {
         ray.validate()?;
         Ok(self.cast_valid(ray, false))
     }
 
-    /// Whether `ray` hits the mesh: some hit (not necessarily the closest), found
-    /// with an early exit. Fails on an invalid ray.
-    pub fn ray_hits_any(&self, ray: &Ray) -> Result<Option<RayHit>> {
+    /// Whether `ray` hits the mesh at all: stops at the first hit found, which
+    /// need not be the closest. O(log n) typical. Fails on an invalid ray.
+    pub fn intersects_ray(&self, ray: &Ray) -> Result<bool> {
         ray.validate()?;
-        Ok(self.cast_valid(ray, true))
+        Ok(self.cast_valid(ray, true).is_some())
     }
 
     /// [`RayBvh::cast_ray`] for the segment from `seg.a` (`t = 0`) to `seg.b` (`t = 1`).
-    pub fn cast_segment(&self, seg: &Segment) -> Result<Option<RayHit>> {
+    pub fn cast_segment(&self, seg: &Segment) -> Result<Option<TriangleHit>> {
         self.cast_ray(&seg.to_ray())
     }
 
-    /// The cast of a validated ray.
-    pub(crate) fn cast_valid(&self, ray: &Ray, any: bool) -> Option<RayHit> {
+    /// The cast of a validated ray (`any`: stop at the first hit found).
+    pub(crate) fn cast_valid(&self, ray: &Ray, any: bool) -> Option<TriangleHit> {
         let inv = Vec3::ONE / ray.dir;
         let finite = inv.is_finite();
         if !finite || self.root_link & LEAF != 0 {
@@ -161,11 +114,11 @@ impl RayBvh {
         ray: &Ray,
         any: bool,
         entry: impl Fn(&RayNode, f32) -> (Vec4, u32),
-    ) -> Option<RayHit> {
+    ) -> Option<TriangleHit> {
         let filter = RayFilter::new(ray);
         // The exact test's per-ray setup, on the first triangle that needs it.
         let mut woop: Option<WoopRay> = None;
-        let mut best: Option<RayHit> = None;
+        let mut best: Option<TriangleHit> = None;
         let mut limit = ray.max_t;
         let mut stack = Stack::new();
         let mut cur = self.root_link;
@@ -274,7 +227,7 @@ impl RayBvh {
         filter: &RayFilter,
         ray: &Ray,
         woop: &mut Option<WoopRay>,
-        best: &mut Option<RayHit>,
+        best: &mut Option<TriangleHit>,
         any: bool,
     ) -> bool {
         // Lanes by estimate (at most four: insertion; NaN estimates compare
@@ -312,13 +265,8 @@ impl RayBvh {
                 continue;
             };
             let id = self.ids[k as usize];
-            if super::ray::closer(h.t, id, *best) {
-                *best = Some(RayHit {
-                    triangle: id,
-                    t: h.t,
-                    u: h.u,
-                    v: h.v,
-                });
+            if h.precedes(id, best) {
+                *best = Some(h.on(id));
                 if any {
                     return true;
                 }

@@ -1,7 +1,7 @@
 //! [`RayBvh`]: a BVH laid out for ray casts only.
 
-use super::build::BuildOptions;
-use super::tree::Bvh;
+use super::options::BuildOptions;
+use super::tree::{Bvh, Node};
 use crate::geom::Aabb;
 use crate::narrow::bv::BoundingVolume;
 use crate::narrow::ray_triangle::{prepare_triangle, TriPacket};
@@ -90,7 +90,8 @@ impl RayTri {
 ///
 /// Memory: 128 bytes per node + about 135 bytes per triangle (at most
 /// `leaf_size` triangles per leaf). After deforming the mesh, call
-/// [`RayBvh::refit`].
+/// [`RayBvh::refit`]. A [`Mesh`](crate::narrow::Mesh) owns one, built on its
+/// first cast; this type alone serves experiments with its layout.
 #[derive(Clone, Debug)]
 pub struct RayBvh {
     pub(crate) nodes: Vec<RayNode>,
@@ -115,34 +116,51 @@ impl RayBvh {
     /// Builds a [`Bvh<Aabb>`] down to one triangle per leaf with `options.split`,
     /// then re-lays it out for rays: a subtree of at most `options.leaf_size`
     /// triangles becomes one leaf where the surface-area cost model says testing
-    /// its triangles is cheaper than descending (see the private `Plan::sah`), and the
+    /// its triangles is cheaper than descending (`Plan::sah` in the source), and the
     /// 4-wide nodes pull up the grandchildren of largest surface area. O(n log n).
     ///
-    /// Fails on `leaf_size == 0`.
+    /// Fails with [`Error::InvalidParameter`] on `leaf_size == 0`.
     pub fn build(mesh: &TriMesh, options: BuildOptions) -> Result<RayBvh> {
-        if options.leaf_size == 0 {
-            return Err(Error::Invalid("BVH leaf size must be at least 1".into()));
+        options.check()?;
+        Ok(RayBvh::build_valid(mesh, options))
+    }
+
+    /// [`RayBvh::build`] with options already checked.
+    pub(crate) fn build_valid(mesh: &TriMesh, options: BuildOptions) -> RayBvh {
+        let bvh = Bvh::<Aabb>::build_valid(mesh, binary(options));
+        RayBvh::with_plan(&bvh, mesh, &Plan::sah(&bvh, mesh, options.leaf_size))
+    }
+
+    /// [`RayBvh::build`] of `mesh`, the mesh `bvh` was built over, reusing `bvh`
+    /// when it is the binary tree that build starts from (built with `options`'
+    /// split rule and leaf size 1; the topology does not depend on the volume),
+    /// so that only the O(n) layout remains: the same tree, unless `mesh` was
+    /// deformed since, in which case it keeps the topology of the first vertices
+    /// (as [`Bvh::refit`] does: as exact, maybe less tight).
+    pub(crate) fn build_reusing<BV: BoundingVolume>(
+        bvh: &Bvh<BV>,
+        mesh: &TriMesh,
+        options: BuildOptions,
+    ) -> RayBvh {
+        if bvh.options == binary(options) {
+            RayBvh::with_plan(bvh, mesh, &Plan::sah(bvh, mesh, options.leaf_size))
+        } else {
+            RayBvh::build_valid(mesh, options)
         }
-        let bvh = Bvh::<Aabb>::build(
-            mesh,
-            BuildOptions {
-                leaf_size: 1,
-                ..options
-            },
-        )?;
-        RayBvh::with_plan(&bvh, mesh, &Plan::sah(&bvh, options.leaf_size))
     }
 
     /// The ray layout of `bvh`'s topology over `mesh` (boxes recomputed from the
     /// vertices, whatever `bvh`'s volume): the same leaves. O(n).
     ///
-    /// Fails if `mesh` has a different vertex count from the one `bvh` was built on.
+    /// Fails with [`Error::MeshMismatch`] if `mesh` is not the one `bvh` was built
+    /// (or last refit) over.
     pub fn from_bvh<BV: BoundingVolume>(bvh: &Bvh<BV>, mesh: &TriMesh) -> Result<RayBvh> {
-        RayBvh::with_plan(bvh, mesh, &Plan::same(bvh))
+        bvh.check_mesh(mesh)?;
+        Ok(RayBvh::with_plan(bvh, mesh, &Plan::same(bvh)))
     }
 
-    fn with_plan<BV: BoundingVolume>(bvh: &Bvh<BV>, mesh: &TriMesh, plan: &Plan) -> Result<RayBvh> {
-        bvh.check_vertices(mesh.vertices().len())?;
+    /// The tree of `plan` over `bvh`, the tree of `mesh`.
+    fn with_plan<BV: BoundingVolume>(bvh: &Bvh<BV>, mesh: &TriMesh, plan: &Plan) -> RayBvh {
         let mut t = RayBvh {
             nodes: Vec::with_capacity(bvh.nodes.len() / 2 + 1),
             leaves: Vec::new(),
@@ -156,13 +174,13 @@ impl RayBvh {
         };
         t.root_link = t.collapse(&bvh.nodes, plan, 0);
         t.fit(mesh.vertices());
-        Ok(t)
+        t
     }
 
     /// Collapses the binary subtree at `old[i]` into 4-wide nodes (pre-order, so
     /// children have larger indices than parents), with the leaves of `plan`;
     /// returns its link.
-    fn collapse<BV>(&mut self, old: &[super::Node<BV>], plan: &Plan, i: u32) -> u32 {
+    fn collapse<BV>(&mut self, old: &[Node<BV>], plan: &Plan, i: u32) -> u32 {
         if plan.leaf[i as usize] {
             let [s, n] = plan.range[i as usize];
             self.leaves.push([s, n, 0]);
@@ -295,6 +313,14 @@ impl RayBvh {
     }
 }
 
+/// The binary tree a ray tree is planned from: `options` down to single triangles.
+fn binary(options: BuildOptions) -> BuildOptions {
+    BuildOptions {
+        leaf_size: 1,
+        ..options
+    }
+}
+
 /// Relative cost of one packet pre-test (four triangles) in the surface-area
 /// model of [`Plan::sah`] (the unit).
 const COST_PACKET: f32 = 1.0;
@@ -330,17 +356,38 @@ impl Plan {
     /// when `area · (COST_LEAF + COST_PACKET · ⌈count / 4⌉)` is no more than the cost
     /// of keeping it, `area · COST_NODE` plus its children's costs (the chance of a
     /// random ray hitting a box is proportional to its area). Children are opened by
-    /// surface area. O(nodes).
-    fn sah(bvh: &Bvh<Aabb>, max_leaf: usize) -> Plan {
+    /// surface area. The areas are those of the nodes' boxes over `mesh`'s
+    /// vertices, whatever `bvh`'s volume (for a `Bvh<Aabb>`, its own volumes).
+    /// O(nodes).
+    fn sah<BV: BoundingVolume>(bvh: &Bvh<BV>, mesh: &TriMesh, max_leaf: usize) -> Plan {
         let n = &bvh.nodes;
         let area = |b: &Aabb| {
             let e = b.extent();
             e.x * e.y + e.y * e.z + e.z * e.x
         };
+        // The boxes bottom-up (children have larger indices): leaves from their
+        // corners, parents as unions, as a `Bvh<Aabb>` fits them.
+        let v = mesh.vertices();
+        let mut boxes = vec![Aabb::EMPTY; n.len()];
+        for i in (0..n.len()).rev() {
+            boxes[i] = if n[i].is_leaf() {
+                let mut b = Aabb::EMPTY;
+                for t in &bvh.tris[n[i].triangle_range()] {
+                    for &k in t {
+                        b.min = b.min.min(v[k as usize]);
+                        b.max = b.max.max(v[k as usize]);
+                    }
+                }
+                b
+            } else {
+                let (l, r) = n[i].children(i as u32);
+                boxes[l as usize].union(&boxes[r as usize])
+            };
+        }
         let mut p = Plan {
             leaf: vec![false; n.len()],
             range: vec![[0, 0]; n.len()],
-            key: n.iter().map(|n| area(&n.bv)).collect(),
+            key: boxes.iter().map(area).collect(),
         };
         let mut cost = vec![0.0f32; n.len()];
         // Children have larger indices: a reverse sweep is bottom-up.

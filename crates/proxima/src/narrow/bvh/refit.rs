@@ -3,22 +3,26 @@
 
 use super::tree::{coord_bound, Bvh};
 use crate::narrow::bv::BoundingVolume;
+use crate::narrow::TriMesh;
 use crate::{Error, Result};
 use glam::Vec3;
 
 impl<BV: BoundingVolume> Bvh<BV> {
-    /// Refits every volume to new vertex positions (same count and triangles, e.g.
-    /// a deformed mesh), keeping the topology: leaves from their triangles, then
+    /// Refits every volume to the current vertices of `mesh`, the mesh the tree
+    /// was built over, after [`TriMesh::set_vertices`] deformed it (same
+    /// triangles), keeping the topology: leaves from their triangles, then
     /// internal nodes from their children in one reverse (bottom-up) sweep. O(n).
     ///
     /// Exact for AABB and k-DOPs; OBBs keep their axes; spheres merge. The tree may
     /// become less efficient after large deformations (rebuild then), never wrong.
-    /// Fails, changing nothing, on a vertex count mismatch or a non-finite vertex.
-    pub fn refit(&mut self, vertices: &[Vec3]) -> Result<()> {
-        self.check_vertices(vertices.len())?;
-        if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
-            return Err(Error::InvalidMesh(format!("vertex {i} is not finite")));
+    /// Fails with [`Error::MeshMismatch`], changing nothing, on any other mesh.
+    pub fn refit(&mut self, mesh: &TriMesh) -> Result<()> {
+        if mesh.stamp().topology != self.mesh.topology {
+            return Err(Error::MeshMismatch(
+                "the BVH was built over another mesh".into(),
+            ));
         }
+        let vertices = mesh.vertices();
         let mut pts: Vec<Vec3> = Vec::new();
         for i in (0..self.nodes.len()).rev() {
             let n = self.nodes[i];
@@ -35,6 +39,7 @@ impl<BV: BoundingVolume> Bvh<BV> {
             self.nodes[i].bv = bv;
         }
         self.coord_bound = coord_bound(vertices);
+        self.mesh = mesh.stamp();
         Ok(())
     }
 

@@ -1,6 +1,6 @@
 //! Simultaneous traversal of two BVHs [sources: bvh-traverse].
 
-use super::tree::Bvh;
+use super::tree::{Bvh, Node};
 use crate::narrow::bv::BoundingVolume;
 
 /// Where the moving tree's volumes come from during a traversal, and how they are
@@ -14,7 +14,7 @@ pub(crate) trait VolumeSource<BV> {
 
 /// The tree's own volumes, moved by a prepared motion inside the test.
 pub(crate) struct Local<'a, BV: BoundingVolume> {
-    pub nodes: &'a [super::Node<BV>],
+    pub nodes: &'a [Node<BV>],
     pub motion: BV::Motion,
 }
 
@@ -47,7 +47,7 @@ impl<BV: BoundingVolume> VolumeSource<BV> for Precomputed<'_, BV> {
 /// Volumes transformed on first use ([`BoundingVolume::transformed`]) and enlarged
 /// by the slack, counting each as one node update.
 pub(crate) struct Lazy<'a, BV> {
-    pub nodes: &'a [super::Node<BV>],
+    pub nodes: &'a [Node<BV>],
     pub pose: glam::Affine3A,
     pub slack: f32,
     pub cache: &'a mut super::tri_cache::QueryCache<BV>,
@@ -121,14 +121,14 @@ pub(crate) fn traverse<BV: BoundingVolume>(
 }
 
 #[inline]
-fn push_a<BV>(stack: &mut Vec<(u32, u32)>, na: &super::Node<BV>, ia: u32, ib: u32) {
+fn push_a<BV>(stack: &mut Vec<(u32, u32)>, na: &Node<BV>, ia: u32, ib: u32) {
     let (l, r) = na.children(ia);
     stack.push((r, ib));
     stack.push((l, ib));
 }
 
 #[inline]
-fn push_b<BV>(stack: &mut Vec<(u32, u32)>, nb: &super::Node<BV>, ia: u32, ib: u32) {
+fn push_b<BV>(stack: &mut Vec<(u32, u32)>, nb: &Node<BV>, ia: u32, ib: u32) {
     let (l, r) = nb.children(ib);
     stack.push((ia, r));
     stack.push((ia, l));

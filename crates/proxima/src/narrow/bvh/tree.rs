@@ -1,7 +1,10 @@
 //! The BVH: one flat array of small nodes, children by index (Box2D / parry style).
 
-use super::build::BuildOptions;
+use super::options::BuildOptions;
 use crate::narrow::bv::BoundingVolume;
+use crate::narrow::trimesh::MeshStamp;
+use crate::narrow::TriMesh;
+use crate::{Error, Result};
 
 /// One node: its volume and either its triangle range (leaf) or its right child.
 ///
@@ -38,13 +41,17 @@ impl<BV> Node<BV> {
     }
 }
 
-/// A binary bounding-volume hierarchy over the triangles of a
-/// [`TriMesh`](crate::narrow::TriMesh), generic over the [`BoundingVolume`].
+/// A binary bounding-volume hierarchy over the triangles of a [`TriMesh`],
+/// generic over the [`BoundingVolume`]: the low-level tree that a
+/// [`Mesh`](crate::narrow::Mesh) owns, for experiments with volumes and split
+/// rules over one separate `TriMesh`.
 ///
 /// The tree keeps its own copy of the triangles' vertex indices, permuted so that
 /// each leaf covers a contiguous range, and reads vertex *positions* from the mesh
-/// at query time: after [`TriMesh::set_vertices`](crate::narrow::TriMesh::set_vertices)
-/// call [`Bvh::refit`]. Built by [`Bvh::build`] (top-down, binary: [sources: bvh-build]).
+/// at query time: every call that takes the mesh fails with
+/// [`Error::MeshMismatch`] unless it is the mesh the tree was built over (or a
+/// clone), with the vertices of the last build or [`Bvh::refit`]. Built by
+/// [`Bvh::build`] (top-down, binary: [sources: bvh-build]).
 #[derive(Clone, Debug)]
 pub struct Bvh<BV> {
     pub(crate) nodes: Vec<Node<BV>>,
@@ -52,7 +59,8 @@ pub struct Bvh<BV> {
     pub(crate) tris: Vec<[u32; 3]>,
     /// `ids[k]`: index in the mesh of `tris[k]`.
     pub(crate) ids: Vec<u32>,
-    pub(crate) n_vertices: usize,
+    /// The mesh (and its vertex version) the volumes were fitted to.
+    pub(crate) mesh: MeshStamp,
     /// Max over vertices of `|x| + |y| + |z|` (for the rounding slack).
     pub(crate) coord_bound: f32,
     pub(crate) options: BuildOptions,
@@ -100,15 +108,22 @@ impl<BV: BoundingVolume> Bvh<BV> {
         best
     }
 
-    /// Checks that `vertices` can be used with this tree (same count as at build).
-    pub(crate) fn check_vertices(&self, n: usize) -> crate::Result<()> {
-        if n != self.n_vertices {
-            return Err(crate::Error::InvalidMesh(format!(
-                "BVH was built over {} vertices, mesh has {n}",
-                self.n_vertices
-            )));
+    /// Checks that `mesh` is the one the tree was built over, with the vertices
+    /// its volumes were last fitted to. O(1).
+    pub(crate) fn check_mesh(&self, mesh: &TriMesh) -> Result<()> {
+        let s = mesh.stamp();
+        // Geometry stamps are never reused: equal ones mean the same topology too.
+        if s.geometry == self.mesh.geometry {
+            return Ok(());
         }
-        Ok(())
+        if s.topology != self.mesh.topology {
+            return Err(Error::MeshMismatch(
+                "the BVH was built over another mesh".into(),
+            ));
+        }
+        Err(Error::MeshMismatch(
+            "the mesh's vertices changed since the BVH was built or refit (refit it)".into(),
+        ))
     }
 }
 

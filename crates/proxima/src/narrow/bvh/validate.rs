@@ -1,24 +1,29 @@
 //! Structural invariants of a BVH (for tests and debugging).
 
 use super::tree::Bvh;
-use crate::narrow::bv::BoundingVolume;
+use crate::narrow::bv::{slack_for, BoundingVolume};
+use crate::narrow::TriMesh;
 use crate::{Error, Result};
-use glam::Vec3;
 
 impl<BV: BoundingVolume> Bvh<BV> {
-    /// Checks the invariants: pre-order layout (children after their parent, left
-    /// child at `i + 1`), every node reached once, leaves non-empty with at most
-    /// `leaf_size` triangles, the leaves' ranges partitioning the triangle order,
-    /// `triangle_order` a permutation, and every triangle corner of `vertices`
-    /// inside its leaf's and every ancestor's volume (tested as a zero-size volume
+    /// Checks the invariants against `mesh`, the mesh the tree was built over:
+    /// pre-order layout (children after their parent, left child at `i + 1`),
+    /// every node reached once, leaves non-empty with at most `leaf_size`
+    /// triangles, the leaves' ranges partitioning the triangle order,
+    /// `triangle_order` a permutation, and every triangle corner of the mesh inside
+    /// its leaf's and every ancestor's volume (tested as a zero-size volume
     /// overlapping it, with a small tolerance). O(n log n).
-    pub fn validate(&self, vertices: &[Vec3]) -> Result<()> {
+    ///
+    /// Fails with [`Error::Invalid`] naming the first broken invariant, or
+    /// [`Error::MeshMismatch`] for another mesh.
+    pub fn validate(&self, mesh: &TriMesh) -> Result<()> {
         let bad = |m: String| Err(Error::Invalid(m));
-        self.check_vertices(vertices.len())?;
+        self.check_mesh(mesh)?;
+        let vertices = mesh.vertices();
         let n = self.nodes.len();
         let mut seen = vec![false; n];
         let mut covered = vec![false; self.tris.len()];
-        let slack = super::super::bv::slack_for(4.0 * self.coord_bound, 0.0);
+        let slack = slack_for(4.0 * self.coord_bound, 0.0);
         let still = BV::motion(&glam::Affine3A::IDENTITY, slack);
         // (node, ancestors' indices)
         let mut stack: Vec<(usize, Vec<usize>)> = vec![(0, Vec::new())];

@@ -5,7 +5,7 @@
 //! small triangle (3 % of the bunny's rays missed); the adapter uses a two-sided
 //! Möller–Trumbore in `f32` instead (the same test as obvhs's).
 
-use crate::w6::RayCaster;
+use super::caster::RayCaster;
 use bvh::aabb::{Aabb, Bounded};
 use bvh::bounding_hierarchy::BHShape;
 use bvh::bvh::Bvh;

@@ -2,7 +2,7 @@
 //! `RayCast::cast_local_ray_and_get_normal` (closest hit, `solid = false`: a ray
 //! starting inside reports the first surface crossing, as ours does).
 
-use crate::w6::RayCaster;
+use super::caster::RayCaster;
 use parry3d::math::Vector;
 use parry3d::query::{Ray as PRay, RayCast};
 use parry3d::shape::{FeatureId, TriMesh as PTriMesh};

@@ -5,7 +5,7 @@
 //! `CwBvh::ray_traverse` for the closest hit with `RtTriangle::intersect` (its own
 //! Möller–Trumbore test, `f32`, not watertight).
 
-use crate::w6::RayCaster;
+use super::caster::RayCaster;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray as ORay, RayHit as OHit};

@@ -1,0 +1,49 @@
+//! The traversal stack of the ray casts ([`Stack`]), on the machine stack.
+
+/// Slots of the traversal stack kept on the machine stack (deeper trees spill).
+const STACK: usize = 16;
+
+/// A LIFO of `(node, entry t)` on the machine stack, spilling to the heap only for
+/// trees deeper than [`STACK`]. Items are packed in a `u64` (node in the low half,
+/// the bits of `t` in the high half) so that creating the stack, once per ray,
+/// is a few vector stores rather than one store per field.
+pub(crate) struct Stack {
+    items: [u64; STACK],
+    len: usize,
+    spill: Vec<u64>,
+}
+
+impl Stack {
+    #[inline(always)]
+    pub(crate) fn new() -> Stack {
+        Stack {
+            items: [0; STACK],
+            len: 0,
+            spill: Vec::new(),
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn push(&mut self, (i, t): (u32, f32)) {
+        let x = i as u64 | (t.to_bits() as u64) << 32;
+        if self.len < STACK {
+            self.items[self.len] = x;
+            self.len += 1;
+        } else {
+            self.spill.push(x);
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn pop(&mut self) -> Option<(u32, f32)> {
+        let x = match self.spill.pop() {
+            Some(x) => x,
+            None if self.len == 0 => return None,
+            None => {
+                self.len -= 1;
+                self.items[self.len]
+            }
+        };
+        Some((x as u32, f32::from_bits((x >> 32) as u32)))
+    }
+}

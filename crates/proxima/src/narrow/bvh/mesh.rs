@@ -34,7 +34,7 @@ use std::sync::OnceLock;
 /// Queries: [`Mesh::collide`] / [`Mesh::collide_first`] against another mesh
 /// (with a [`Collider`](crate::narrow::Collider) for a loop of them),
 /// [`Mesh::cast_ray`] / [`Mesh::intersects_ray`] / [`Mesh::cast_segment`], and
-/// [`Mesh::cast_rays_par`] (feature `parallel`). [`Mesh::set_vertices`] deforms
+/// `Mesh::cast_rays_par` (feature `parallel`). [`Mesh::set_vertices`] deforms
 /// it, refitting both trees.
 ///
 /// `Send + Sync` (the lazy ray tree is a [`OnceLock`]): share one in an `Arc`

@@ -15,10 +15,10 @@
 
 use super::keys::{KeyBox, LIMIT};
 use super::HashGrid;
-use crate::arena::Handle;
 use crate::broad::cell_list::CellEntry;
 use crate::broad::RayHit;
 use crate::geom::{overlap, Ray, Sphere};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 /// Relative padding of the ray's coordinates (rounding of `o + d t`).
@@ -319,7 +319,7 @@ impl<T> HashGrid<T> {
 
     /// The first hit (smallest `t`, ties by handle): the oversized objects first,
     /// then the walk, stopping once a hit precedes the strip just finished.
-    pub(super) fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
+    pub(super) fn ray_first_cells(&self, ray: &Ray) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
         for &slot in &self.oversized {
             if let Some(t) = overlap::ray_sphere(ray, &self.spheres[slot as usize]) {
@@ -347,12 +347,13 @@ impl<T> HashGrid<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::HashGridConfig;
     use crate::broad::{BruteForce, HashGrid, SpatialIndex};
     use crate::geom::{Ray, Segment, Sphere};
     use glam::{vec3, Vec3};
 
     fn sample() -> (HashGrid<u32>, BruteForce<u32>) {
-        let mut g = HashGrid::with_cell_size(3.0).unwrap();
+        let mut g = HashGrid::with_config(HashGridConfig { cell_size: 3.0 }).unwrap();
         let mut b = BruteForce::new();
         let mut k = 0u32;
         let mut add = |s: Sphere| {

@@ -4,9 +4,9 @@
 use super::node::{FixedStack, NIL};
 use super::store::CHUNK;
 use super::LooseKdTree;
-use crate::arena::Handle;
 use crate::broad::{RayHit, Selection};
 use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
+use crate::Handle;
 use glam::Vec3;
 use std::ops::{ControlFlow, Range};
 

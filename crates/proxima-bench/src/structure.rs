@@ -68,11 +68,10 @@ impl Structure for Indexed {
     }
 
     fn update(&mut self, spheres: &[Sphere]) {
-        for (h, s) in self.handles.iter().zip(spheres) {
-            self.index
-                .update(*h, *s)
-                .unwrap_or_else(|e| panic!("update to {s:?} failed: {e}"));
-        }
+        let moves = self.handles.iter().copied().zip(spheres.iter().copied());
+        self.index
+            .update_many(moves)
+            .unwrap_or_else(|e| panic!("update failed: {e}"));
     }
 
     fn count_pairs(&mut self) -> u64 {

@@ -20,7 +20,9 @@ use std::ops::ControlFlow;
 /// [`count_pairs`](AnyIndex::count_pairs) mean the same as the
 /// [`SpatialIndexExt`](super::SpatialIndexExt) methods of those names but pass
 /// the closure itself to the index's walk, so a pair search or a query with many
-/// hits makes no dynamic call per object. The variants are public so that a
+/// hits makes no dynamic call per object; its
+/// [`update_many`](AnyIndex::update_many) matches once per batch, so a frame's
+/// moves run the index's own update inlined in one loop. The variants are public so that a
 /// caller can reach an index's own methods (statistics, node views).
 #[derive(Clone, Debug)]
 #[non_exhaustive]
@@ -86,6 +88,21 @@ impl<T> AnyIndex<T> {
         f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         each!(self, i => i.walk_pairs(f))
+    }
+
+    /// [`SpatialIndexExt::update_many`](super::SpatialIndexExt::update_many)
+    /// with one `match` per batch instead of one per object.
+    pub fn update_many(&mut self, moves: impl IntoIterator<Item = (Handle, Sphere)>) -> Result<()>
+    where
+        T: Send + Sync,
+    {
+        let moves = moves.into_iter();
+        each!(self, i => {
+            for (h, s) in moves {
+                i.update(h, s)?;
+            }
+            Ok(())
+        })
     }
 
     /// Every overlapping pair once, as `(a, b)` with `a < b`, in no particular

@@ -78,6 +78,13 @@ pub trait SpatialIndexExt<T>: SpatialIndex<T> {
         out
     }
 
+    /// Moves/resizes each `(handle, sphere)` in turn (a frame's motion), as
+    /// [`SpatialIndex::update`] would one by one. Stops at the first error:
+    /// that object and the later ones are unchanged, the earlier ones moved.
+    fn update_many(&mut self, moves: impl IntoIterator<Item = (Handle, Sphere)>) -> Result<()> {
+        moves.into_iter().try_for_each(|(h, s)| self.update(h, s))
+    }
+
     /// Number of overlapping pairs.
     fn count_pairs(&self) -> u64 {
         let mut n = 0;

@@ -312,6 +312,8 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     }
 
     /// Seed `Move`; see the type's docs for when the object changes node.
+    /// Inline: a frame's update loop then holds the common in-node move.
+    #[inline]
     fn update(&mut self, handle: Handle, sphere: Sphere) -> Result<()> {
         sphere.validate()?;
         let loc = *self.items.get(handle)?;

@@ -8,7 +8,7 @@ use crate::geom::{overlap, Sphere};
 use crate::{Handle, Result};
 use std::ops::ControlFlow;
 
-/// Stores spheres in an [`Arena`] and answers every query by testing each one.
+/// Stores spheres in a generational arena and answers every query by testing each one.
 ///
 /// Insert, remove and update are O(1); queries are O(n); pairs are O(n²). Its
 /// answers are the definition of right for every other index (same closed tests

@@ -16,6 +16,23 @@ pub struct RayHit {
     pub t: f32,
 }
 
+impl RayHit {
+    /// Keeps in `best` the first hit of a ray: the smaller `t`, ties broken by
+    /// the smaller handle (the order every first-hit search reports). Returns
+    /// whether `(t, handle)` replaced it. O(1).
+    #[inline]
+    pub(crate) fn offer(best: &mut Option<RayHit>, t: f32, handle: Handle) -> bool {
+        let better = match best {
+            None => true,
+            Some(b) => (t, handle) < (b.t, b.handle),
+        };
+        if better {
+            *best = Some(RayHit { handle, t });
+        }
+        better
+    }
+}
+
 /// The interface every broad-phase index implements: a set of bounding spheres,
 /// each with a payload `T`, named by [`Handle`]s.
 ///

@@ -34,13 +34,7 @@ pub(crate) trait Walk<T> {
         let mut best: Option<RayHit> = None;
         let _ = self.walk(ray, |h, s, _| {
             if let Some(t) = overlap::ray_sphere(ray, s) {
-                let better = match best {
-                    None => true,
-                    Some(b) => (t, h) < (b.t, b.handle),
-                };
-                if better {
-                    best = Some(RayHit { handle: h, t });
-                }
+                RayHit::offer(&mut best, t, h);
             }
             ControlFlow::Continue(())
         });

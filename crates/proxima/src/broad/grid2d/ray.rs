@@ -178,14 +178,7 @@ impl<T> UniformGrid2d<T> {
         let _ = self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
                 if let Some(t) = overlap::ray_sphere(ray, &self.spheres[e.slot as usize]) {
-                    let h = self.handles[e.slot as usize];
-                    let better = match best {
-                        None => true,
-                        Some(b) => (t, h) < (b.t, b.handle),
-                    };
-                    if better {
-                        best = Some(RayHit { handle: h, t });
-                    }
+                    RayHit::offer(&mut best, t, self.handles[e.slot as usize]);
                 }
                 ControlFlow::Continue(())
             }

@@ -41,18 +41,6 @@ fn meet(a0: i32, a1: i32, b0: i32, b1: i32) -> bool {
     a0.max(b0) <= a1.min(b1)
 }
 
-/// Keeps the smaller of `best` and `(t, h)`.
-#[inline]
-fn offer(best: &mut Option<RayHit>, t: f32, h: Handle) {
-    let better = match best {
-        None => true,
-        Some(b) => (t, h) < (b.t, b.handle),
-    };
-    if better {
-        *best = Some(RayHit { handle: h, t });
-    }
-}
-
 impl<T> HashGrid<T> {
     fn walk_ray(
         &self,
@@ -323,13 +311,13 @@ impl<T> HashGrid<T> {
         let mut best: Option<RayHit> = None;
         for &slot in &self.oversized {
             if let Some(t) = overlap::ray_sphere(ray, &self.spheres[slot as usize]) {
-                offer(&mut best, t, self.handles[slot as usize]);
+                RayHit::offer(&mut best, t, self.handles[slot as usize]);
             }
         }
         let _ = self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
                 if let Some(t) = overlap::ray_sphere(ray, &self.spheres[e.slot as usize]) {
-                    offer(&mut best, t, self.handles[e.slot as usize]);
+                    RayHit::offer(&mut best, t, self.handles[e.slot as usize]);
                 }
                 ControlFlow::Continue(())
             }

@@ -98,7 +98,7 @@ impl OctreeConfig {
 /// the box's longest extent (the seed's cells are cubes; a flat world thus gets
 /// cubic cells, not slabs). Every node is named by its [`LocationCode`]; a
 /// [`FxHashMap`] from code to node index replaces pointers for random access (the
-/// seed's MAP), and nodes live in a [`Pool`] with a free list. Inner nodes also keep
+/// seed's MAP), and nodes live in a pool with a free list. Inner nodes also keep
 /// the indices of their children for top-down traversals. The tree is sparse: a
 /// split creates only the octants that receive objects, and an object moving into
 /// empty space creates the one leaf it needs. Emptied leaves are deleted.

@@ -17,10 +17,10 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     };
     let hint = t.scene_hint();
     let mut runs = Vec::new();
-    for name in indices::NAMES {
-        match replay::run_one(name, &hint, &t) {
+    for kind in proxima::broad::IndexKind::ALL {
+        match replay::run_one(kind.name(), &hint, &t) {
             Ok(r) => runs.push(r),
-            Err(e) => panic!("{name} rejects a checked trace: {e}"),
+            Err(e) => panic!("{kind} rejects a checked trace: {e}"),
         }
     }
     if let Some((i, r, _)) = replay::disagreement(&runs) {

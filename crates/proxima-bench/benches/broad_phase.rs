@@ -26,7 +26,7 @@ fn workload_group(c: &mut Criterion, kind: Kind, n: usize) {
     let mut ledger = PairLedger::new();
     for entry in entries().iter().filter(|e| e.runs_on(n)) {
         let mut w = Workload::new(kind, n, SEED);
-        let mut s = (entry.make)(&w.scene());
+        let mut s = entry.make(&w.scene());
         s.build(&w.spheres);
         group.bench_function(BenchmarkId::from_parameter(entry.name), |b| {
             b.iter(|| {

@@ -7,9 +7,9 @@
 //!
 //! - [`workloads`]: the deterministic scene generators;
 //! - [`structure`]: the object-safe [`structure::Structure`] interface and the
-//!   adapter over any `SpatialIndex<u32>`;
+//!   adapter over the library's `AnyIndex<u32>`;
 //! - [`parry`]: the parry3d BVH adapter;
-//! - [`registry`]: the list of structures (one line per index);
+//! - [`registry`]: the list of structures (every `IndexKind`, then the peers);
 //! - [`w5`]: the mesh-vs-mesh workload W5 and its peer [`parry_mesh`];
 //! - [`w6`]: rays vs one mesh (its own runner, table and agreement check), with
 //!   its peers (obvhs, bvh, parry3d's `TriMesh`) beside it, as W4's are;

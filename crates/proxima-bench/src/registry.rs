@@ -1,13 +1,10 @@
-//! The list of structures every benchmark runs. Adding a Proxima index is one
-//! `proxima!` line in [`entries`].
+//! The list of structures every benchmark runs: Proxima's indices, one per
+//! [`IndexKind`] (named by their type), then the peers.
 
 use crate::parry::ParryBvh;
-use crate::structure::{Indexed, IndexedPar, Structure};
+use crate::structure::{Indexed, Structure};
 use crate::workloads::Scene;
-use proxima::broad::{
-    loose_kd, BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, UniformGrid2d,
-    UniformGrid3d,
-};
+use proxima::broad::IndexKind;
 
 /// One benchmarked structure: a name and how to make it empty for a scene.
 pub struct Entry {
@@ -17,11 +14,31 @@ pub struct Entry {
     pub quadratic: bool,
     /// True for the peers (not Proxima's own indices).
     pub peer: bool,
-    /// Makes the empty structure for a scene.
-    pub make: fn(&Scene) -> Box<dyn Structure>,
+    maker: Maker,
+}
+
+/// How an entry makes its empty structure.
+enum Maker {
+    /// A Proxima index, built by the library for the scene's hint.
+    Index(IndexKind),
+    /// A peer's adapter.
+    Peer(fn(&Scene) -> Box<dyn Structure>),
 }
 
 impl Entry {
+    /// Makes the empty structure for a scene.
+    pub fn make(&self, scene: &Scene) -> Box<dyn Structure> {
+        match self.maker {
+            Maker::Index(kind) => {
+                let index = kind
+                    .build(&scene.hint())
+                    .unwrap_or_else(|e| panic!("{}: {e}", self.name));
+                Box::new(Indexed::new(index))
+            }
+            Maker::Peer(make) => make(scene),
+        }
+    }
+
     /// Whether this structure is affordable on `n` objects.
     pub fn runs_on(&self, n: usize) -> bool {
         !self.quadratic || n <= QUADRATIC_LIMIT
@@ -34,75 +51,30 @@ pub const QUADRATIC_LIMIT: usize = 20_000;
 /// Name of the reference peer that frame-time ratios are taken against.
 pub const PARRY: &str = "parry3d";
 
-/// A Proxima index: `proxima!(name, |scene| constructor)`, the constructor
-/// returning `proxima::Result<Index>` for the empty index (it may read
-/// `scene.world`, `scene.r_max`, ...). `proxima!(name, quadratic, ...)` marks an
-/// index whose pair finding is O(n²).
-macro_rules! proxima {
-    ($name:expr, $make:expr) => {
-        proxima!(@entry $name, false, $make)
-    };
-    ($name:expr, quadratic, $make:expr) => {
-        proxima!(@entry $name, true, $make)
-    };
-    // An index implementing `ParallelPairs` (used by `--threads K`).
-    ($name:expr, parallel, $make:expr) => {
-        Entry {
-            name: $name,
-            quadratic: false,
-            peer: false,
-            make: |scene: &Scene| -> Box<dyn Structure> {
-                let make: fn(&Scene) -> proxima::Result<_> = $make;
-                let index = make(scene).unwrap_or_else(|e| panic!("{}: {e}", $name));
-                Box::new(IndexedPar(Indexed::<_>::new(index)))
-            },
-        }
-    };
-    (@entry $name:expr, $quadratic:expr, $make:expr) => {
-        Entry {
-            name: $name,
-            quadratic: $quadratic,
-            peer: false,
-            make: |scene: &Scene| -> Box<dyn Structure> {
-                let make: fn(&Scene) -> proxima::Result<_> = $make;
-                let index = make(scene).unwrap_or_else(|e| panic!("{}: {e}", $name));
-                Box::new(Indexed::<_>::new(index))
-            },
-        }
-    };
-}
-
-/// Every structure, Proxima's indices first, then the peers.
+/// Every structure, Proxima's indices first (in [`IndexKind::ALL`] order, the
+/// brute-force oracle being the one whose pair finding is O(n²)), then the peers.
 pub fn entries() -> Vec<Entry> {
-    vec![
-        proxima!("BruteForce", quadratic, |_| Ok(BruteForce::new())),
-        proxima!("LooseKdTree", parallel, |s| LooseKdTree::new(
-            s.world,
-            s.r_max,
-            loose_kd::DEFAULT_DENSITY
-        )),
-        proxima!("LinearOctree", |s| LinearOctree::new(
-            s.world,
-            OctreeConfig::default()
-        )),
-        proxima!("UniformGrid2d", |s| UniformGrid2d::new(s.world, s.r_max)),
-        proxima!("HashGrid", |s| HashGrid::new(s.r_max)),
-        proxima!("UniformGrid3d", parallel, |s| UniformGrid3d::new(
-            s.world, s.r_max
-        )),
+    let ours = IndexKind::ALL.into_iter().map(|kind| Entry {
+        name: kind.type_name(),
+        quadratic: kind == IndexKind::Brute,
+        peer: false,
+        maker: Maker::Index(kind),
+    });
+    let peers = [
         Entry {
             name: PARRY,
             quadratic: false,
             peer: true,
-            make: |_| Box::new(ParryBvh::new(true)),
+            maker: Maker::Peer(|_| Box::new(ParryBvh::new(true))),
         },
         Entry {
             name: "parry3d-noopt",
             quadratic: false,
             peer: true,
-            make: |_| Box::new(ParryBvh::new(false)),
+            maker: Maker::Peer(|_| Box::new(ParryBvh::new(false))),
         },
-    ]
+    ];
+    ours.chain(peers).collect()
 }
 
 /// The entries whose name matches one of `names` (all of them when `names` is

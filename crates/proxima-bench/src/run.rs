@@ -204,7 +204,7 @@ pub fn measure_threads(
             .expect("building the benchmark's thread pool")
     });
     let mut w = Workload::new(kind, n, seed);
-    let mut s: Box<dyn Structure> = (entry.make)(&w.scene());
+    let mut s: Box<dyn Structure> = entry.make(&w.scene());
     let ((), build) = clock.time(|| s.build(&w.spheres));
     let mut m = Measurement {
         name: entry.name,

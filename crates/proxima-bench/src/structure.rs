@@ -1,9 +1,9 @@
 //! One object-safe interface over everything the benchmarks run: Proxima's indices
-//! (through [`Indexed`], generic over [`SpatialIndex<u32>`]) and the peers.
+//! (through [`Indexed`], over the library's [`AnyIndex`]) and the peers.
 
-use proxima::broad::{Handle, ParallelPairs, SpatialIndex};
+use proxima::broad::{AnyIndex, ParallelPairs, SpatialIndex};
 use proxima::geom::Sphere;
-use std::ops::ControlFlow;
+use proxima::Handle;
 
 /// A broad-phase structure as the workloads drive it: object `i` is sphere `i` of
 /// the workload, inserted once, moved every frame, and all overlapping pairs
@@ -20,7 +20,7 @@ pub trait Structure {
     fn count_pairs(&mut self) -> u64;
 
     /// As [`Structure::count_pairs`], split over the threads of `pool` by the
-    /// structures that implement [`ParallelPairs`] (`--threads K`). The default
+    /// structures that have a parallel search (`--threads K`). The default
     /// counts sequentially on the calling thread.
     fn count_pairs_par(&mut self, pool: &rayon::ThreadPool) -> u64 {
         let _ = pool;
@@ -31,16 +31,18 @@ pub trait Structure {
     fn memory_bytes(&self) -> usize;
 }
 
-/// Drives any Proxima index through [`SpatialIndex<u32>`]: the payload of object
-/// `i` is `i`, and the handles are kept in insertion order.
-pub struct Indexed<I> {
-    index: I,
+/// Drives any Proxima index through [`AnyIndex<u32>`]: the payload of object
+/// `i` is `i`, and the handles are kept in insertion order. Pairs are counted
+/// with `AnyIndex`'s statically dispatched search, in parallel with its
+/// [`ParallelPairs`] (sequential for the indices without a parallel search).
+pub struct Indexed {
+    index: AnyIndex<u32>,
     handles: Vec<Handle>,
 }
 
-impl<I: SpatialIndex<u32>> Indexed<I> {
+impl Indexed {
     /// Wraps an empty index.
-    pub fn new(index: I) -> Self {
+    pub fn new(index: AnyIndex<u32>) -> Self {
         Indexed {
             index,
             handles: Vec::new(),
@@ -48,12 +50,12 @@ impl<I: SpatialIndex<u32>> Indexed<I> {
     }
 
     /// The wrapped index.
-    pub fn index(&self) -> &I {
+    pub fn index(&self) -> &AnyIndex<u32> {
         &self.index
     }
 }
 
-impl<I: SpatialIndex<u32>> Structure for Indexed<I> {
+impl Structure for Indexed {
     fn build(&mut self, spheres: &[Sphere]) {
         self.handles.reserve(spheres.len());
         for (i, s) in spheres.iter().enumerate() {
@@ -66,51 +68,23 @@ impl<I: SpatialIndex<u32>> Structure for Indexed<I> {
     }
 
     fn update(&mut self, spheres: &[Sphere]) {
-        for (h, s) in self.handles.iter().zip(spheres) {
-            self.index
-                .update(*h, *s)
-                .unwrap_or_else(|e| panic!("update to {s:?} failed: {e}"));
-        }
+        let moves = self.handles.iter().copied().zip(spheres.iter().copied());
+        self.index
+            .update_many(moves)
+            .unwrap_or_else(|e| panic!("update failed: {e}"));
     }
 
     fn count_pairs(&mut self) -> u64 {
-        let mut n = 0u64;
-        let _ = self.index.for_each_pair(|_, _, _, _| {
-            n += 1;
-            ControlFlow::Continue(())
-        });
-        n
+        self.index.count_pairs()
+    }
+
+    fn count_pairs_par(&mut self, pool: &rayon::ThreadPool) -> u64 {
+        let index = &self.index;
+        pool.install(|| index.par_count_pairs())
     }
 
     fn memory_bytes(&self) -> usize {
         // The handle list is the benchmark's, not the index's: not counted.
         self.index.memory_bytes()
-    }
-}
-
-/// [`Indexed`] for an index with parallel pair finding: `count_pairs_par` runs
-/// `par_count_pairs` inside the given pool.
-pub struct IndexedPar<I>(pub Indexed<I>);
-
-impl<I: ParallelPairs<u32>> Structure for IndexedPar<I> {
-    fn build(&mut self, spheres: &[Sphere]) {
-        self.0.build(spheres)
-    }
-
-    fn update(&mut self, spheres: &[Sphere]) {
-        self.0.update(spheres)
-    }
-
-    fn count_pairs(&mut self) -> u64 {
-        self.0.count_pairs()
-    }
-
-    fn count_pairs_par(&mut self, pool: &rayon::ThreadPool) -> u64 {
-        let index = &self.0.index;
-        pool.install(|| index.par_count_pairs())
-    }
-
-    fn memory_bytes(&self) -> usize {
-        self.0.memory_bytes()
     }
 }

@@ -7,6 +7,7 @@
 //! position). Velocities are drawn once, so stepping costs the same for every
 //! structure and needs no random numbers.
 
+use proxima::broad::SceneHint;
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::Vec3;
 use rand::{Rng, SeedableRng};
@@ -70,6 +71,17 @@ pub struct Scene {
     pub r_max: f32,
     /// Mean radius.
     pub r_mean: f32,
+}
+
+impl Scene {
+    /// The scene as the library's index constructors take it (world box and
+    /// largest radius).
+    pub fn hint(&self) -> SceneHint {
+        SceneHint {
+            max_live: self.n,
+            ..SceneHint::new(self.world, self.r_max)
+        }
+    }
 }
 
 /// A deterministic scene of moving spheres.

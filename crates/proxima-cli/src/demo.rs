@@ -12,11 +12,11 @@
 //! the run fails with exit code 1.
 
 use crate::draw::Canvas;
-use crate::indices::{self, IndexJob, BRUTE};
+use crate::indices::{self, BRUTE};
 use crate::pictures::{self, Series};
 use crate::scene::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
-use proxima::broad::SpatialIndex;
+use proxima::broad::{AnyIndex, IndexKind, SpatialIndex};
 use std::io::IsTerminal;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
@@ -126,10 +126,9 @@ struct Frames<'a> {
     bar: &'a ProgressBar,
 }
 
-impl IndexJob for Frames<'_> {
-    type Output = proxima::Result<Row>;
-
-    fn run<I: SpatialIndex<u64>>(&mut self, name: &'static str, mut index: I) -> Self::Output {
+impl Frames<'_> {
+    /// Runs the scene on the empty `index` called `name`.
+    fn run(&self, name: &'static str, mut index: AnyIndex<u64>) -> proxima::Result<Row> {
         let mut scene = Scene::new(self.kind, self.n, self.seed);
         let start = Instant::now();
         let handles = scene
@@ -294,26 +293,26 @@ fn run(args: &Args) -> Result<ExitCode, String> {
         };
         bar.set_prefix(name);
         let start = Instant::now();
-        let mut job = Frames {
+        let job = Frames {
             kind: args.scene,
             n,
             seed: args.seed,
             search: mask,
             bar: &bar,
         };
-        let row = match indices::with_index(name, &hint, &mut job) {
-            Some(Ok(Ok(row))) => row,
-            Some(Ok(Err(e))) => {
+        let kind: IndexKind = name.parse().map_err(|e| format!("{e}"))?;
+        let row = match kind.build(&hint).map(|index| job.run(name, index)) {
+            Ok(Ok(row)) => row,
+            Ok(Err(e)) => {
                 bar.abandon();
                 eprintln!("proxima demo: index {name} failed on the scene: {e}");
                 return Ok(ExitCode::from(1));
             }
-            Some(Err(e)) => {
+            Err(e) => {
                 bar.abandon();
                 eprintln!("proxima demo: index {name} rejects the scene: {e}");
                 return Ok(ExitCode::from(1));
             }
-            None => unreachable!("names come from the registry"),
         };
         bar.finish();
         if terminal {
@@ -555,17 +554,15 @@ mod tests {
             let rows: Vec<Row> = indices::NAMES
                 .iter()
                 .map(|n| {
-                    let job = &mut Frames {
+                    let job = Frames {
                         kind,
                         n: 400,
                         seed: 5,
                         search: &search,
                         bar: &bar,
                     };
-                    indices::with_index(n, &w.hint(), job)
-                        .unwrap()
-                        .unwrap()
-                        .unwrap()
+                    let index = n.parse::<IndexKind>().unwrap().build(&w.hint()).unwrap();
+                    job.run(n, index).unwrap()
                 })
                 .collect();
             assert!(pair_mismatch(&rows).is_none());

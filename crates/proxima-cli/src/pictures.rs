@@ -4,8 +4,8 @@
 //! intersecting triangles.
 
 use crate::draw::{palette, Anchor, Canvas, Rgba, BLACK, GREY};
-use crate::indices::{self, SceneHint};
-use proxima::broad::SpatialIndex;
+use crate::indices::SceneHint;
+use proxima::broad::{LinearOctree, LooseKdConfig, LooseKdTree, OctreeConfig, SpatialIndex};
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::{Affine3A, Vec3};
 use proxima::narrow::TriMesh;
@@ -125,7 +125,8 @@ fn ramp_legend(c: &mut Canvas, x: f32, y: f32, label: &str, lo: usize, hi: usize
 /// zones (where the two children overlap) shaded, and the spheres cut by the plane
 /// coloured by the depth of the node holding them [sources: figures].
 pub fn kd_partition(spheres: &[Sphere], hint: &SceneHint) -> Result<Canvas, String> {
-    let mut tree = indices::loose_kd(hint).map_err(|e| e.to_string())?;
+    let mut tree =
+        LooseKdTree::with_config(LooseKdConfig::for_scene(hint)).map_err(|e| e.to_string())?;
     let handles = spheres
         .iter()
         .enumerate()
@@ -286,7 +287,8 @@ pub fn kd_partition(spheres: &[Sphere], hint: &SceneHint) -> Result<Canvas, Stri
 /// they hold, and the bounding boxes of the objects cut by the plane
 /// [sources: figures].
 pub fn octree_partition(spheres: &[Sphere], hint: &SceneHint) -> Result<Canvas, String> {
-    let mut tree = indices::octree(hint).map_err(|e| e.to_string())?;
+    let mut tree =
+        LinearOctree::with_config(OctreeConfig::for_scene(hint)).map_err(|e| e.to_string())?;
     for (i, s) in spheres.iter().enumerate() {
         tree.insert(*s, i as u64).map_err(|e| e.to_string())?;
     }

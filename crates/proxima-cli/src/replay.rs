@@ -5,10 +5,11 @@
 //! answer with the brute-force oracle. Exit codes: 0 success, 1 an index disagrees
 //! with brute force, 2 bad input (file, line, option).
 
-use crate::indices::{self, IndexJob, SceneHint, BRUTE};
+use crate::indices::{self, SceneHint, BRUTE};
 use crate::trace::{Kind, Op, Query, Trace};
-use proxima::broad::{Handle, SpatialIndex};
+use proxima::broad::{AnyIndex, IndexKind, SpatialIndex, SpatialIndexExt};
 use proxima::geom::Sphere;
+use proxima::Handle;
 use std::fmt;
 use std::io::{self, Write};
 use std::ops::ControlFlow;
@@ -78,10 +79,9 @@ struct Replay<'a> {
     trace: &'a Trace,
 }
 
-impl IndexJob for Replay<'_> {
-    type Output = Result<Run, (usize, String)>;
-
-    fn run<I: SpatialIndex<u64>>(&mut self, name: &'static str, mut index: I) -> Self::Output {
+impl Replay<'_> {
+    /// Replays the trace on the empty `index` called `name`.
+    fn run(&self, name: &'static str, mut index: AnyIndex<u64>) -> Result<Run, (usize, String)> {
         let t = self.trace;
         let mut handles: Vec<Option<Handle>> = vec![None; t.ids.len()];
         let mut answers = Vec::with_capacity(t.query_count());
@@ -107,8 +107,8 @@ impl IndexJob for Replay<'_> {
 }
 
 /// Applies one operation; queries return their answer.
-fn apply<I: SpatialIndex<u64>>(
-    index: &mut I,
+fn apply(
+    index: &mut AnyIndex<u64>,
     handles: &mut [Option<Handle>],
     ids: &[u64],
     op: &Op,
@@ -138,15 +138,15 @@ fn apply<I: SpatialIndex<u64>>(
             Answer::Pairs(n)
         }
         Op::Query(Query::Sphere(s)) => {
-            let _ = index.query_sphere(s, counter(&mut n))?;
+            let _ = index.for_each_in(*s, counter(&mut n))?;
             Answer::Sphere(n)
         }
         Op::Query(Query::Aabb(b)) => {
-            let _ = index.query_aabb(b, counter(&mut n))?;
+            let _ = index.for_each_in(*b, counter(&mut n))?;
             Answer::Aabb(n)
         }
         Op::Query(Query::Frustum(fr)) => {
-            let _ = index.query_frustum(fr, counter(&mut n))?;
+            let _ = index.for_each_in(**fr, counter(&mut n))?;
             Answer::Frustum(n)
         }
         Op::Query(Query::Ray(ray)) => {
@@ -271,12 +271,13 @@ pub fn disagreement(runs: &[Run]) -> Option<(usize, &Run, &Run)> {
 }
 
 pub fn run_one(idx: &str, hint: &SceneHint, trace: &Trace) -> Result<Run, String> {
-    match indices::with_index(idx, hint, &mut Replay { trace }) {
-        None => Err(format!("unknown index '{idx}'")),
-        Some(Err(e)) => Err(format!("index {idx} rejects the scene: {e}")),
-        Some(Ok(Err((pos, msg)))) => Err(format!("line {}: {msg}", trace.lines[pos])),
-        Some(Ok(Ok(run))) => Ok(run),
-    }
+    let kind: IndexKind = idx.parse().map_err(|_| format!("unknown index '{idx}'"))?;
+    let index = kind
+        .build(hint)
+        .map_err(|e| format!("index {idx} rejects the scene: {e}"))?;
+    Replay { trace }
+        .run(kind.name(), index)
+        .map_err(|(pos, msg)| format!("line {}: {msg}", trace.lines[pos]))
 }
 
 /// Source line of each query, in order.

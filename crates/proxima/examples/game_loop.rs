@@ -3,20 +3,20 @@
 //!
 //! `cargo run --release --example game_loop`
 
-use proxima::broad::{LooseKdTree, SpatialIndex};
+use proxima::broad::{LooseKdTree, SpatialIndex, SpatialIndexExt};
 use proxima::geom::{Aabb, Frustum, Sphere};
 use proxima::glam::{Mat4, Vec3};
 
 /// What the game keeps per object; the index stores a copy of the id as payload.
 struct Body {
-    handle: proxima::broad::Handle,
+    handle: proxima::Handle,
     velocity: Vec3,
 }
 
 fn main() -> proxima::Result<()> {
     let world = Aabb::new(Vec3::ZERO, Vec3::splat(100.0));
-    // Loose k-d tree: world box, largest radius, density [sources: kd-tree].
-    let mut index = LooseKdTree::<usize>::new(world, 1.0, 0.25)?;
+    // Loose k-d tree: world box and largest typical radius [sources: kd-tree].
+    let mut index = LooseKdTree::<usize>::new(world, 1.0)?;
 
     // Spawn 2000 bodies on a deterministic pseudo-random lattice.
     let mut bodies = Vec::new();
@@ -54,7 +54,7 @@ fn main() -> proxima::Result<()> {
             std::ops::ControlFlow::Continue(())
         });
         // What the camera sees.
-        let visible = index.frustum_hits(&frustum)?.len();
+        let visible = index.query(frustum)?.len();
         // Who is near the centre (a radius query).
         let near = index.within(Vec3::splat(50.0), 10.0)?.len();
         println!(

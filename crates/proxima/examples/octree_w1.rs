@@ -6,7 +6,7 @@
 //! `cargo run --release -p proxima --example octree_w1 -- [N] [frames] [max_per_leaf] [flat]`
 //! (criterion benches against peers live in the bench crate; this is a quick look.)
 
-use proxima::broad::{LinearOctree, OctreeConfig, SpatialIndex};
+use proxima::broad::{LinearOctree, OctreeConfig, SpatialIndex, SpatialIndexExt};
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::{vec3, Vec3};
 use rand::{Rng, SeedableRng};
@@ -41,9 +41,9 @@ fn main() {
     let cfg = OctreeConfig {
         max_per_leaf: mpl,
         merge_below: mpl / 2,
-        ..Default::default()
+        ..OctreeConfig::new(world)
     };
-    let mut t = LinearOctree::new(world, cfg).unwrap();
+    let mut t = LinearOctree::with_config(cfg).unwrap();
     let mut objs: Vec<(Sphere, Vec3)> = (0..n)
         .map(|_| {
             let c = vec3(
@@ -104,7 +104,7 @@ fn main() {
     let t0 = now();
     let mut q = 0usize;
     for (h, (s, _)) in hs.iter().zip(&objs) {
-        let _ = t.query_sphere(s, |o, _, _| {
+        let _ = t.for_each_in(*s, |o, _, _| {
             if o > *h {
                 q += 1;
             }

@@ -3,33 +3,8 @@
 //! [`Pool`] with a free list for tree nodes. Both are flat `Vec`s, as in Box2D's
 //! `b2DynamicTree`; this is the "equal-size block allocator" of [sources: block-alloc].
 
-use crate::{Error, Result};
+use crate::{Error, Handle, Result};
 use std::sync::atomic::{AtomicU32, Ordering};
-
-/// A reference to an object stored in an index.
-///
-/// Handles are generational: after `remove` (or `clear`) the same slot may be reused,
-/// but the old handle then fails with [`Error::StaleHandle`] instead of naming a
-/// different object. Each arena also carries a tag drawn when it is created or
-/// cleared, so a handle from another index is rejected too (up to 2^32 arenas).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Handle {
-    tag: u32,
-    index: u32,
-    generation: u32,
-}
-
-impl Handle {
-    /// The slot number: dense, small, stable while the object lives. Useful as an
-    /// index into side tables.
-    pub fn index(self) -> u32 {
-        self.index
-    }
-    /// The slot's generation when this handle was issued.
-    pub fn generation(self) -> u32 {
-        self.generation
-    }
-}
 
 static NEXT_TAG: AtomicU32 = AtomicU32::new(1);
 
@@ -107,6 +82,7 @@ impl<V> Arena<V> {
     }
 
     /// Number of slots (live or free): the capacity in use.
+    #[cfg(test)]
     pub fn slot_count(&self) -> usize {
         self.slots.len()
     }
@@ -276,25 +252,6 @@ impl<V> Arena<V> {
             })
     }
 
-    /// Live `(handle, value)` pairs in slot order, mutably.
-    pub fn iter_mut(&mut self) -> impl Iterator<Item = (Handle, &mut V)> + '_ {
-        let tag = self.tag;
-        self.slots
-            .iter_mut()
-            .enumerate()
-            .filter_map(move |(i, s)| match &mut s.entry {
-                Entry::Occupied(v) => Some((
-                    Handle {
-                        tag,
-                        index: i as u32,
-                        generation: s.generation,
-                    },
-                    v,
-                )),
-                Entry::Vacant { .. } => None,
-            })
-    }
-
     /// Bytes of heap memory held (capacity, not just length).
     pub fn heap_bytes(&self) -> usize {
         self.slots.capacity() * std::mem::size_of::<Slot<V>>()
@@ -409,6 +366,8 @@ impl<N> std::ops::IndexMut<u32> for Pool<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::broad::LooseKdConfig;
+    use crate::broad::SpatialIndexExt;
 
     #[test]
     fn stale_and_foreign_handles_are_rejected() {
@@ -438,8 +397,8 @@ mod tests {
     #[test]
     fn capacity() {
         use crate::broad::{
-            BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex,
-            UniformGrid2d, UniformGrid3d,
+            BruteForce, HashGrid, LinearOctree, LooseKdTree, SpatialIndex, UniformGrid2d,
+            UniformGrid3d,
         };
         use crate::geom::{Aabb, Sphere};
         use glam::{vec3, Vec3};
@@ -457,7 +416,7 @@ mod tests {
                 .collect();
             let snapshot = |i: &I| {
                 let mut all = Vec::new();
-                i.for_each(|h, s, v| all.push((h, *s, *v)));
+                i.for_each(&mut |h, s, v| all.push((h, *s, *v)));
                 (all, i.pairs(), i.memory_bytes(), i.len())
             };
             let before = snapshot(&i);
@@ -491,8 +450,14 @@ mod tests {
         a.validate().unwrap();
         let world = Aabb::new(Vec3::ZERO, Vec3::splat(100.0));
         check(BruteForce::new());
-        check(LooseKdTree::new(world, 2.0, 0.5).unwrap());
-        check(LinearOctree::new(world, OctreeConfig::default()).unwrap());
+        check(
+            LooseKdTree::with_config(LooseKdConfig {
+                density: 0.5,
+                ..LooseKdConfig::new(world, 2.0)
+            })
+            .unwrap(),
+        );
+        check(LinearOctree::new(world).unwrap());
         check(UniformGrid2d::new(world, 2.0).unwrap());
         check(HashGrid::new(2.0).unwrap());
         check(UniformGrid3d::new(world, 2.0).unwrap());

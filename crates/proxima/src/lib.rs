@@ -4,9 +4,13 @@
 //!
 //! - [`geom`]: the primitive shapes (`Sphere`, `Aabb`, `Ray`, `Segment`, `Plane`,
 //!   `Frustum`) and the one implementation of every closed overlap test between them.
-//! - [`broad`]: the [`broad::SpatialIndex`] trait over bounding spheres and its
-//!   indices: [`broad::BruteForce`] (the oracle) and the loose k-d tree of the first
-//!   source document, with more to come.
+//! - [`broad`]: six indices over bounding spheres behind the object-safe
+//!   [`broad::SpatialIndex`] trait (with the conveniences of
+//!   [`broad::SpatialIndexExt`]): [`broad::BruteForce`] (the oracle),
+//!   [`broad::LooseKdTree`], [`broad::LinearOctree`], [`broad::UniformGrid2d`],
+//!   [`broad::HashGrid`] and [`broad::UniformGrid3d`]; [`broad::AnyIndex`] holds
+//!   whichever one an [`broad::IndexKind`] names at run time. Stored objects are
+//!   named by [`Handle`]s.
 //! - [`narrow`]: [`narrow::Mesh`], a triangle mesh that owns its trees: a k-DOP,
 //!   OBB, AABB or sphere BVH for exact mesh–mesh collision down to the closed
 //!   triangle–triangle test, and a 4-wide BVH for exact ray casts; the generic
@@ -19,15 +23,17 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod arena;
+mod arena;
 pub mod broad;
 mod error;
 pub mod geom;
+mod handle;
 pub mod io;
 pub mod narrow;
 
 pub use error::{Error, FileLocation, IoError, Result};
 pub use glam;
+pub use handle::Handle;
 
 /// The root README's examples, compiled and run as doctests (`cargo test`).
 #[doc = include_str!("../../../README.md")]

@@ -5,12 +5,13 @@
 //! `BruteForce` or with hand-computed exact values.
 
 use proxima::broad::{
-    BruteForce, Handle, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex,
+    AnyIndex, BruteForce, Grid2dConfig, Grid3dConfig, HashGrid, HashGridConfig, IndexKind,
+    LinearOctree, LooseKdConfig, LooseKdTree, SceneHint, SpatialIndex, SpatialIndexExt,
     UniformGrid2d, UniformGrid3d,
 };
 use proxima::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};
 use proxima::glam::{vec3, Mat4, Vec3};
-use proxima::Error;
+use proxima::{Error, Handle};
 use std::collections::BTreeSet;
 use std::ops::ControlFlow;
 
@@ -18,34 +19,49 @@ fn world() -> Aabb {
     Aabb::new(Vec3::ZERO, Vec3::splat(100.0))
 }
 
-/// One test function per index, each calling `$body::<Index>(make)`.
+/// The index of `kind` these tests run: each config's `for_scene` over
+/// `world()` with radius 2, except a denser loose k-d tree (deeper nodes).
+fn make(kind: IndexKind) -> AnyIndex<u32> {
+    let hint = SceneHint::new(world(), 2.0);
+    match kind {
+        IndexKind::LooseKd => LooseKdTree::with_config(LooseKdConfig {
+            density: 0.5,
+            ..LooseKdConfig::for_scene(&hint)
+        })
+        .unwrap()
+        .into(),
+        _ => kind.build(&hint).unwrap(),
+    }
+}
+
+/// One test function per index kind, each calling `$body(make)`.
 macro_rules! per_index {
     ($body:ident) => {
         mod $body {
             use super::*;
             #[test]
             fn brute() {
-                super::$body(&|| BruteForce::new());
+                super::$body(&|| make(IndexKind::Brute));
             }
             #[test]
             fn loose_kd() {
-                super::$body(&|| LooseKdTree::new(world(), 2.0, 0.5).unwrap());
+                super::$body(&|| make(IndexKind::LooseKd));
             }
             #[test]
             fn octree() {
-                super::$body(&|| LinearOctree::new(world(), OctreeConfig::default()).unwrap());
+                super::$body(&|| make(IndexKind::Octree));
             }
             #[test]
             fn grid2d() {
-                super::$body(&|| UniformGrid2d::new(world(), 2.0).unwrap());
+                super::$body(&|| make(IndexKind::Grid2d));
             }
             #[test]
             fn hash_grid() {
-                super::$body(&|| HashGrid::new(2.0).unwrap());
+                super::$body(&|| make(IndexKind::HashGrid));
             }
             #[test]
             fn grid3d() {
-                super::$body(&|| UniformGrid3d::new(world(), 2.0).unwrap());
+                super::$body(&|| make(IndexKind::Grid3d));
             }
         }
     };
@@ -73,15 +89,15 @@ fn agrees<I: SpatialIndex<u32>>(i: &I, spheres: &[(u32, Sphere)], queries: &[Sph
     }
     for q in queries {
         assert_eq!(
-            ids(i, i.sphere_hits(q).unwrap()),
-            ids(&b, b.sphere_hits(q).unwrap()),
+            ids(i, i.query(*q).unwrap()),
+            ids(&b, b.query(*q).unwrap()),
             "sphere {q:?}"
         );
         let bx = q.aabb();
         if bx.validate().is_ok() {
             assert_eq!(
-                ids(i, i.aabb_hits(&bx).unwrap()),
-                ids(&b, b.aabb_hits(&bx).unwrap()),
+                ids(i, i.query(bx).unwrap()),
+                ids(&b, b.query(bx).unwrap()),
                 "aabb {bx:?}"
             );
         }
@@ -111,13 +127,13 @@ fn hundred_k_at_one_point<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
     );
     assert_eq!(i.within(p + Vec3::splat(10.0), 1.0).unwrap().len(), 0);
     let b = Aabb::new(p + Vec3::splat(1.0), p + Vec3::splat(2.0));
-    assert!(i.aabb_hits(&b).unwrap().is_empty());
+    assert!(i.query(b).unwrap().is_empty());
     let r = Ray::new(p - vec3(10.0, 0.0, 0.0), Vec3::X);
     assert_eq!(i.ray_hits(&r).unwrap().len(), N_POINT as usize);
     assert_eq!(i.ray_first(&r).unwrap().unwrap().t, 9.0);
     // Early stop is honoured.
     let mut n = 0;
-    let _ = i.query_sphere(&Sphere::new(p, 1.0), |_, _, _| {
+    let _ = i.for_each_in(Sphere::new(p, 1.0), |_, _, _| {
         n += 1;
         ControlFlow::Break(())
     });
@@ -261,10 +277,10 @@ fn bad_input_is_rejected_and_changes_nothing<I: SpatialIndex<u32>>(make: &dyn Fn
     for s in bad {
         assert!(i.insert(s, 1).is_err());
         assert!(i.update(h, s).is_err());
-        assert!(i.sphere_hits(&s).is_err());
+        assert!(i.query(s).is_err());
     }
-    assert!(i.aabb_hits(&Aabb::new(Vec3::ONE, Vec3::ZERO)).is_err());
-    assert!(i.aabb_hits(&Aabb::new(Vec3::NAN, Vec3::ZERO)).is_err());
+    assert!(i.query(Aabb::new(Vec3::ONE, Vec3::ZERO)).is_err());
+    assert!(i.query(Aabb::new(Vec3::NAN, Vec3::ZERO)).is_err());
     assert_eq!(
         i.ray_hits(&Ray::new(Vec3::ZERO, Vec3::ZERO)).err(),
         Some(Error::ZeroDirection)
@@ -273,7 +289,9 @@ fn bad_input_is_rejected_and_changes_nothing<I: SpatialIndex<u32>>(make: &dyn Fn
     assert!(i
         .ray_hits(&Ray::with_max_t(Vec3::ZERO, Vec3::X, -1.0))
         .is_err());
-    assert!(i.segment_hits(&Segment::new(Vec3::ONE, Vec3::ONE)).is_err());
+    assert!(i
+        .ray_hits(&Segment::new(Vec3::ONE, Vec3::ONE).to_ray())
+        .is_err());
     assert!(Frustum::from_view_projection(Mat4::NAN).is_err());
     assert_eq!(i.len(), 1);
     assert_eq!(i.get(h).unwrap(), (Sphere::new(Vec3::splat(10.0), 1.0), &7));
@@ -328,11 +346,7 @@ fn sphere_sphere_exact_at_1e30() {
 /// and the frustum query reported the object without testing it.
 #[test]
 fn octree_frustum_infinite_loose_box() {
-    let mut o = LinearOctree::new(
-        Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0)),
-        OctreeConfig::default(),
-    )
-    .unwrap();
+    let mut o = LinearOctree::new(Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0))).unwrap();
     let mut b = BruteForce::new();
     for (k, s) in [
         Sphere::new(vec3(-32.0, 3.4028235e38, -32.0), 0.0),
@@ -348,11 +362,8 @@ fn octree_frustum_infinite_loose_box() {
     let m = Mat4::perspective_rh(1.0, 1.0, 0.1, 50.0)
         * Mat4::look_at_rh(vec3(0.0, 0.0, 20.0), Vec3::ZERO, Vec3::Y);
     let f = Frustum::from_view_projection(m).unwrap();
-    assert_eq!(
-        ids(&o, o.frustum_hits(&f).unwrap()),
-        ids(&b, b.frustum_hits(&f).unwrap())
-    );
-    assert!(!ids(&o, o.frustum_hits(&f).unwrap()).contains(&0));
+    assert_eq!(ids(&o, o.query(f).unwrap()), ids(&b, b.query(f).unwrap()));
+    assert!(!ids(&o, o.query(f).unwrap()).contains(&0));
 }
 
 /// Fuzz (index_ops, proptest): a segment query on a hash grid holding objects
@@ -360,7 +371,7 @@ fn octree_frustum_infinite_loose_box() {
 /// magnitude): it hung. Wide strips are now served from the map of occupied cells.
 #[test]
 fn hash_grid_ray_wide_strip_hang() {
-    let mut g = HashGrid::with_cell_size(1.0).unwrap();
+    let mut g = HashGrid::with_config(HashGridConfig { cell_size: 1.0 }).unwrap();
     let mut b = BruteForce::new();
     let spheres = [
         Sphere::new(Vec3::ZERO, 1.0),
@@ -418,12 +429,12 @@ fn grid_far_ball_cell_padding() {
         b.insert(s, k).unwrap();
     }
     assert_eq!(
-        n(g2.segment_hits(&seg).unwrap()),
-        n(b.segment_hits(&seg).unwrap())
+        n(g2.ray_hits(&seg.to_ray()).unwrap()),
+        n(b.ray_hits(&seg.to_ray()).unwrap())
     );
     assert_eq!(
-        n(hg.segment_hits(&seg).unwrap()),
-        n(b.segment_hits(&seg).unwrap())
+        n(hg.ray_hits(&seg.to_ray()).unwrap()),
+        n(b.ray_hits(&seg.to_ray()).unwrap())
     );
 }
 
@@ -433,7 +444,7 @@ fn aabb_center_does_not_overflow() {
     let b = Aabb::new(Vec3::splat(2e38), Vec3::splat(3e38));
     assert_eq!(b.center(), Vec3::splat(2.5e38));
     assert!(b.half_extent().is_finite());
-    let o = LinearOctree::<u32>::new(b, OctreeConfig::default());
+    let o = LinearOctree::<u32>::new(b);
     assert!(o.is_ok());
 }
 
@@ -443,7 +454,7 @@ fn aabb_center_does_not_overflow() {
 /// at the (padded) cell of the ray's end.
 #[test]
 fn hash_grid_far_segment_strip_loop() {
-    let mut g = HashGrid::with_cell_size(1.0).unwrap();
+    let mut g = HashGrid::with_config(HashGridConfig { cell_size: 1.0 }).unwrap();
     let mut b = BruteForce::new();
     for (k, s) in [
         Sphere::new(vec3(-3e38, -8192.0, -32.0), 16.5),
@@ -458,8 +469,8 @@ fn hash_grid_far_segment_strip_loop() {
     let seg = Segment::new(vec3(1e20, -32.0, -32.0), vec3(-32.0, -32.0, -32.0));
     let n = |h: Vec<proxima::broad::RayHit>| h.len();
     assert_eq!(
-        n(g.segment_hits(&seg).unwrap()),
-        n(b.segment_hits(&seg).unwrap())
+        n(g.ray_hits(&seg.to_ray()).unwrap()),
+        n(b.ray_hits(&seg.to_ray()).unwrap())
     );
     let r = Ray::with_max_t(vec3(1e20, -32.0, -32.0), vec3(-1e20, 0.0, 0.0), 1.0);
     assert_eq!(n(g.ray_hits(&r).unwrap()), n(b.ray_hits(&r).unwrap()));
@@ -480,8 +491,11 @@ fn frustum_zero_normal_plane_consistent() {
         overlap::frustum_sphere(&f, &big),
         proxima::geom::Relation::Outside
     );
-    let mut kd =
-        LooseKdTree::new(Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0)), 2.0, 0.5).unwrap();
+    let mut kd = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0)), 2.0)
+    })
+    .unwrap();
     let mut b = BruteForce::new();
     for (k, s) in [Sphere::new(vec3(-8192.0, 0.0, -32.0), 0.0), big]
         .into_iter()
@@ -490,8 +504,8 @@ fn frustum_zero_normal_plane_consistent() {
         kd.insert(s, k as u32).unwrap();
         b.insert(s, k as u32).unwrap();
     }
-    assert!(b.frustum_hits(&f).unwrap().is_empty());
-    assert!(kd.frustum_hits(&f).unwrap().is_empty());
+    assert!(b.query(f).unwrap().is_empty());
+    assert!(kd.query(f).unwrap().is_empty());
     // A plane with a scaled normal is the same half-space.
     planes[5] = Plane::new(vec3(0.0, 0.0, 2.0), 0.0);
     let f = Frustum::from_planes(planes);
@@ -522,7 +536,7 @@ fn hash_grid_empty_strip_range() {
     }
     // The inputs run in tests/ops (fuzz_found_inputs_pass); here a direct case:
     // objects spread to ±1e9 on z, none in the ray's y range.
-    let mut g = HashGrid::with_cell_size(1.0).unwrap();
+    let mut g = HashGrid::with_config(HashGridConfig { cell_size: 1.0 }).unwrap();
     let mut b = BruteForce::new();
     for (k, s) in [
         Sphere::new(vec3(0.0, 0.0, 1e9), 1.0),
@@ -549,7 +563,7 @@ fn hash_grid_empty_strip_range() {
 fn hash_grid_huge_cell_loose_box() {
     let big = Sphere::new(vec3(25.25, -21.5, -15.75), f32::MAX);
     let far = Sphere::new(vec3(-4.25, -3e38, 4352.0), 18.875);
-    let mut g = HashGrid::with_cell_size(3e38).unwrap();
+    let mut g = HashGrid::with_config(HashGridConfig { cell_size: 3e38 }).unwrap();
     let mut b = BruteForce::new();
     for (i, s) in [big, far].into_iter().enumerate() {
         g.insert(s, i as u32).unwrap();
@@ -558,7 +572,7 @@ fn hash_grid_huge_cell_loose_box() {
     g.validate().unwrap();
     assert_eq!(g.pairs().len(), 1);
     assert_eq!(b.pairs().len(), 1);
-    assert_eq!(g.sphere_hits(&big).unwrap().len(), 2);
+    assert_eq!(g.query(big).unwrap().len(), 2);
 }
 
 /// Found by a 10-minute proptest run: with a cell of 2.6e24 an object at
@@ -571,14 +585,17 @@ fn hash_grid_huge_cell_loose_box() {
 fn hash_grid_pairs_oversized_far_point() {
     let big = Sphere::new(vec3(-32.0, 0.0, -32.0), 1e30);
     let far = Sphere::new(vec3(-32.0, -32.0, -1e30), 0.0);
-    let mut g = HashGrid::with_cell_size(2.6067463e24).unwrap();
+    let mut g = HashGrid::with_config(HashGridConfig {
+        cell_size: 2.6067463e24,
+    })
+    .unwrap();
     let mut b = BruteForce::new();
     for (i, s) in [big, far].into_iter().enumerate() {
         g.insert(s, i as u32).unwrap();
         b.insert(s, i as u32).unwrap();
     }
     assert_eq!(b.pairs().len(), 1);
-    assert_eq!(g.sphere_hits(&big).unwrap().len(), 2);
+    assert_eq!(g.query(big).unwrap().len(), 2);
     assert_eq!(g.pairs().len(), 1, "the grid misses the pair");
     g.validate().unwrap();
 }
@@ -595,7 +612,11 @@ fn grid2d_far_segment_end_hit() {
     let ray = seg.to_ray();
     assert_eq!(overlap::ray_sphere(&ray, &ball), Some(1.0));
     for cell in [0.5, 0.25, 1.0, 2.0, 4.0, 8.0] {
-        let mut g = UniformGrid2d::with_cell_size(w, cell).unwrap();
+        let mut g = UniformGrid2d::with_config(Grid2dConfig {
+            world: w,
+            cell_size: cell,
+        })
+        .unwrap();
         g.insert(ball, 0u32).unwrap();
         g.insert(Sphere::new(Vec3::splat(-32.0), 0.0), 1).unwrap();
         assert_eq!(g.ray_hits(&ray).unwrap().len(), 1, "cell {cell}: ray_hits");
@@ -615,9 +636,21 @@ fn grids_far_balls_near_overflow_match_brute_force() {
     let w = Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0));
     let mut hits = 0;
     for cell in [0.5, 4.0] {
-        hits += far_rays_agree(UniformGrid2d::with_cell_size(w, cell).unwrap());
-        hits += far_rays_agree(UniformGrid3d::with_cell_size(w, cell).unwrap());
-        hits += far_rays_agree(HashGrid::with_cell_size(cell).unwrap());
+        hits += far_rays_agree(
+            UniformGrid2d::with_config(Grid2dConfig {
+                world: w,
+                cell_size: cell,
+            })
+            .unwrap(),
+        );
+        hits += far_rays_agree(
+            UniformGrid3d::with_config(Grid3dConfig {
+                world: w,
+                cell_size: cell,
+            })
+            .unwrap(),
+        );
+        hits += far_rays_agree(HashGrid::with_config(HashGridConfig { cell_size: cell }).unwrap());
     }
     assert!(hits > 100, "the scene must produce hits ({hits})");
 }

@@ -7,7 +7,7 @@
 mod harness;
 
 use harness::{run, SceneParams, ALL_SCENES};
-use proxima::broad::{loose_kd, LooseKdTree};
+use proxima::broad::{LooseKdConfig, LooseKdTree};
 
 const OPS: usize = 3000;
 
@@ -19,25 +19,50 @@ fn suite(make: impl Fn(&SceneParams) -> LooseKdTree<u64> + Copy) {
 
 #[test]
 fn density_0_1() {
-    suite(|p| LooseKdTree::new(p.world, p.r_max, 0.1).unwrap());
+    suite(|p| {
+        LooseKdTree::with_config(LooseKdConfig {
+            density: 0.1,
+            ..LooseKdConfig::new(p.world, p.r_max)
+        })
+        .unwrap()
+    });
 }
 
 #[test]
 fn density_default() {
-    suite(|p| LooseKdTree::new(p.world, p.r_max, loose_kd::DEFAULT_DENSITY).unwrap());
+    suite(|p| LooseKdTree::new(p.world, p.r_max).unwrap());
 }
 
 #[test]
 fn density_1_0() {
-    suite(|p| LooseKdTree::new(p.world, p.r_max, 1.0).unwrap());
+    suite(|p| {
+        LooseKdTree::with_config(LooseKdConfig {
+            density: 1.0,
+            ..LooseKdConfig::new(p.world, p.r_max)
+        })
+        .unwrap()
+    });
 }
 
 #[test]
 fn depth_cap_3() {
-    suite(|p| LooseKdTree::with_max_depth(p.world, p.r_max, 0.5, 3).unwrap());
+    suite(|p| {
+        LooseKdTree::with_config(LooseKdConfig {
+            density: 0.5,
+            max_depth: 3,
+            ..LooseKdConfig::new(p.world, p.r_max)
+        })
+        .unwrap()
+    });
 }
 
 #[test]
 fn r_max_tiny() {
-    suite(|p| LooseKdTree::new(p.world, p.r_max * 0.01, 0.7).unwrap());
+    suite(|p| {
+        LooseKdTree::with_config(LooseKdConfig {
+            density: 0.7,
+            ..LooseKdConfig::new(p.world, p.r_max * 0.01)
+        })
+        .unwrap()
+    });
 }

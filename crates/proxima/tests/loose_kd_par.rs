@@ -10,16 +10,17 @@ mod harness;
 
 use harness::{run, SceneParams, ALL_SCENES};
 use proxima::broad::{
-    loose_kd, BruteForce, Handle, LooseKdTree, ParallelPairs, RayHit, Selection, SpatialIndex,
+    BruteForce, IndexKind, LooseKdConfig, LooseKdTree, ParallelPairs, Query, RayHit, SpatialIndex,
+    SpatialIndexExt,
 };
 use proxima::geom::{Ray, Sphere};
 use proxima::glam::Vec3;
-use proxima::Result;
+use proxima::{Handle, Result};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::ops::ControlFlow;
 
-/// A `LooseKdTree` whose `for_each_pair` also runs `par_pairs` and
+/// A `LooseKdTree` whose `visit_pairs` also runs `par_pairs` and
 /// `par_count_pairs` in a 2-thread pool and checks them against the sequential
 /// pairs; everything else is delegated.
 struct ParCheck {
@@ -59,19 +60,19 @@ impl SpatialIndex<u64> for ParCheck {
     fn clear(&mut self) {
         self.tree.clear()
     }
-    fn for_each(&self, f: impl FnMut(Handle, &Sphere, &u64)) {
+    fn for_each(&self, f: &mut dyn FnMut(Handle, &Sphere, &u64)) {
         self.tree.for_each(f)
     }
-    fn visit<Q: Selection + ?Sized>(
+    fn visit(
         &self,
-        query: &Q,
-        f: impl FnMut(Handle, &Sphere, &u64) -> ControlFlow<()>,
-    ) -> ControlFlow<()> {
+        query: &Query,
+        f: &mut dyn FnMut(Handle, &Sphere, &u64) -> ControlFlow<()>,
+    ) -> Result<ControlFlow<()>> {
         self.tree.visit(query, f)
     }
-    fn for_each_pair(
+    fn visit_pairs(
         &self,
-        f: impl FnMut(Handle, &u64, Handle, &u64) -> ControlFlow<()>,
+        f: &mut dyn FnMut(Handle, &u64, Handle, &u64) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let mut seq: Vec<(Handle, Handle)> = self
             .tree
@@ -84,10 +85,10 @@ impl SpatialIndex<u64> for ParCheck {
         assert_eq!(par, seq, "parallel pairs differ from sequential pairs");
         let count = self.pool.install(|| self.tree.par_count_pairs());
         assert_eq!(count, seq.len() as u64);
-        self.tree.for_each_pair(f)
+        self.tree.visit_pairs(f)
     }
-    fn ray_first_unchecked(&self, ray: &Ray) -> Option<RayHit> {
-        self.tree.ray_first_unchecked(ray)
+    fn ray_first(&self, ray: &Ray) -> Result<Option<RayHit>> {
+        self.tree.ray_first(ray)
     }
     fn validate(&self) -> Result<()> {
         self.tree.validate()
@@ -95,14 +96,23 @@ impl SpatialIndex<u64> for ParCheck {
     fn memory_bytes(&self) -> usize {
         self.tree.memory_bytes()
     }
+    fn kind(&self) -> IndexKind {
+        self.tree.kind()
+    }
 }
 
 #[test]
 fn oracle_scenes_in_a_2_thread_pool() {
     for scene in ALL_SCENES {
-        for (seed, density) in [(1u64, 0.5), (2, loose_kd::DEFAULT_DENSITY), (3, 1.0)] {
+        for (seed, density) in [(1u64, 0.5), (2, LooseKdConfig::DEFAULT_DENSITY), (3, 1.0)] {
             run(scene, seed, 3000, |p: &SceneParams| {
-                ParCheck::new(LooseKdTree::new(p.world, p.r_max, density).unwrap())
+                ParCheck::new(
+                    LooseKdTree::with_config(LooseKdConfig {
+                        density,
+                        ..LooseKdConfig::new(p.world, p.r_max)
+                    })
+                    .unwrap(),
+                )
             });
         }
     }
@@ -120,7 +130,7 @@ fn large_uniform_scenes_match_brute_force() {
         let mut rng = Pcg64::seed_from_u64(seed);
         let side = 4.0 * (n as f32).cbrt();
         let world = proxima::geom::Aabb::new(Vec3::splat(-2.0), Vec3::splat(side + 2.0));
-        let mut tree = LooseKdTree::new(world, 2.0, loose_kd::DEFAULT_DENSITY).unwrap();
+        let mut tree = LooseKdTree::new(world, 2.0).unwrap();
         let mut brute = BruteForce::new();
         let mut handles = Vec::new();
         for i in 0..n as u64 {

@@ -1,12 +1,12 @@
 //! One object-safe interface over every structure W4 queries: Proxima's indices
-//! (through [`Proxima`], generic over [`SpatialIndex<u32>`]) and the peers.
+//! (through [`Proxima`], over the library's [`AnyIndex<u32>`]) and the peers.
 //!
 //! Every answer is exact and closed: a peer's own traversal yields candidates
 //! (AABB, ray or point-radius hits), and the same tests of `proxima::geom::overlap`
 //! (through [`Selection::selects`]) filter them, so hit counts are comparable.
 
 use super::queries::{Batches, QueryKind};
-use proxima::broad::{par_query_counts, Selection, SpatialIndex};
+use proxima::broad::{par_query_counts, AnyIndex, Query, SpatialIndex};
 use proxima::geom::Sphere;
 use rayon::prelude::*;
 use std::ops::ControlFlow;
@@ -40,11 +40,12 @@ pub trait Engine: Sync {
     fn memory_bytes(&self) -> usize;
 }
 
-/// Hits of `q` in `index` through the generic `visit`.
+/// Hits of `q` in `index` through `AnyIndex::for_each_in` (the index's walk for
+/// the query's shape, the counting closure inlined).
 #[inline]
-pub fn visit_count<I: SpatialIndex<u32>, Q: Selection + ?Sized>(index: &I, q: &Q) -> usize {
+pub fn visit_count(index: &AnyIndex<u32>, q: impl Into<Query>) -> usize {
     let mut n = 0usize;
-    let _ = index.visit(q, |_, _, _| {
+    let _ = index.for_each_in(q, |_, _, _| {
         n += 1;
         ControlFlow::Continue(())
     });
@@ -52,13 +53,13 @@ pub fn visit_count<I: SpatialIndex<u32>, Q: Selection + ?Sized>(index: &I, q: &Q
 }
 
 /// Any Proxima index: built by inserting sphere `i` with payload `i`, queried with
-/// `SpatialIndex::visit` (sequential) or `broad::par_query_counts` (parallel).
-pub struct Proxima<I>(pub I);
+/// `AnyIndex::for_each_in` (sequential) or `broad::par_query_counts` (parallel).
+pub struct Proxima(pub AnyIndex<u32>);
 
-impl<I: SpatialIndex<u32>> Proxima<I> {
+impl Proxima {
     /// Inserts every sphere into the empty `index`, in the given order (sphere
     /// `i` always gets payload `i`).
-    pub fn build(mut index: I, spheres: &[Sphere], order: &[u32]) -> Self {
+    pub fn build(mut index: AnyIndex<u32>, spheres: &[Sphere], order: &[u32]) -> Self {
         for &i in order {
             let s = &spheres[i as usize];
             index
@@ -102,13 +103,13 @@ pub fn morton_order(spheres: &[Sphere]) -> Vec<u32> {
     order
 }
 
-impl<I: SpatialIndex<u32>> Engine for Proxima<I> {
+impl Engine for Proxima {
     fn count(&self, b: &Batches, kind: QueryKind, i: usize) -> Option<usize> {
         Some(match kind {
-            QueryKind::Sphere => visit_count(&self.0, &b.spheres[i]),
-            QueryKind::Aabb => visit_count(&self.0, &b.boxes[i]),
-            QueryKind::Ray => visit_count(&self.0, &b.rays[i]),
-            QueryKind::Frustum => visit_count(&self.0, &b.frusta[i]),
+            QueryKind::Sphere => visit_count(&self.0, b.spheres[i]),
+            QueryKind::Aabb => visit_count(&self.0, b.boxes[i]),
+            QueryKind::Ray => visit_count(&self.0, b.rays[i]),
+            QueryKind::Frustum => visit_count(&self.0, b.frusta[i]),
         })
     }
 
@@ -117,15 +118,15 @@ impl<I: SpatialIndex<u32>> Engine for Proxima<I> {
     }
 
     fn counts(&self, b: &Batches, kind: QueryKind, parallel: bool) -> Option<Vec<usize>> {
-        fn run<I: SpatialIndex<u32>, Q: Selection + Sync>(
-            index: &I,
+        fn run<Q: Into<Query> + Copy + Sync>(
+            index: &AnyIndex<u32>,
             qs: &[Q],
             parallel: bool,
         ) -> Vec<usize> {
             if parallel {
                 par_query_counts(index, qs).expect("valid queries")
             } else {
-                qs.iter().map(|q| visit_count(index, q)).collect()
+                qs.iter().map(|&q| visit_count(index, q)).collect()
             }
         }
         Some(match kind {

@@ -23,12 +23,9 @@ pub mod rstar_peer;
 
 use crate::registry::QUADRATIC_LIMIT;
 use crate::run::{median, num, Clock};
-use crate::workloads::{cube_side, Kind, Workload};
+use crate::workloads::{cube_side, Kind, Scene, Workload};
 use engine::{Engine, Proxima};
-use proxima::broad::{
-    loose_kd, BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, UniformGrid2d,
-    UniformGrid3d,
-};
+use proxima::broad::IndexKind;
 use queries::QueryKind;
 use std::fmt::Write;
 use std::time::Duration;
@@ -119,7 +116,24 @@ struct Entry {
     name: &'static str,
     peer: bool,
     quadratic: bool,
-    build: fn(&[proxima::geom::Sphere], &crate::workloads::Scene, bool) -> Box<dyn Engine>,
+    build: Build,
+}
+
+/// How an entry builds its structure over a set of spheres.
+enum Build {
+    /// A Proxima index (Morton or input insertion order).
+    Index(IndexKind),
+    /// A peer's bulk build.
+    Peer(fn(&[proxima::geom::Sphere], &Scene, bool) -> Box<dyn Engine>),
+}
+
+impl Build {
+    fn run(&self, s: &[proxima::geom::Sphere], scene: &Scene, morton: bool) -> Box<dyn Engine> {
+        match self {
+            Build::Index(kind) => Box::new(proxima(*kind, s, scene, morton)),
+            Build::Peer(build) => build(s, scene, morton),
+        }
+    }
 }
 
 /// Insertion order of Proxima's indices: Morton order of the centres (their bulk
@@ -132,84 +146,59 @@ fn order(s: &[proxima::geom::Sphere], morton: bool) -> Vec<u32> {
     }
 }
 
+/// Proxima's index of `kind` as W4 builds it: configured by the library for
+/// the scene's hint, bulk-loaded in the given order.
+fn proxima(kind: IndexKind, s: &[proxima::geom::Sphere], scene: &Scene, morton: bool) -> Proxima {
+    let index = kind
+        .build(&scene.hint())
+        .unwrap_or_else(|e| panic!("{kind}: {e}"));
+    Proxima::build(index, s, &order(s, morton))
+}
+
 fn entries() -> Vec<Entry> {
-    vec![
-        Entry {
-            name: "BruteForce",
-            peer: false,
-            quadratic: true,
-            build: |s, _, m| Box::new(Proxima::build(BruteForce::new(), s, &order(s, m))),
-        },
-        Entry {
-            name: "LooseKdTree",
-            peer: false,
-            quadratic: false,
-            build: |s, sc, m| {
-                let t = LooseKdTree::new(sc.world, sc.r_max, loose_kd::DEFAULT_DENSITY);
-                Box::new(Proxima::build(t.expect("kd params"), s, &order(s, m)))
-            },
-        },
-        Entry {
-            name: "LinearOctree",
-            peer: false,
-            quadratic: false,
-            build: |s, sc, m| {
-                let t = LinearOctree::new(sc.world, OctreeConfig::default());
-                Box::new(Proxima::build(t.expect("octree params"), s, &order(s, m)))
-            },
-        },
-        Entry {
-            name: "HashGrid",
-            peer: false,
-            quadratic: false,
-            build: |s, sc, m| {
-                let t = HashGrid::new(sc.r_max).expect("grid params");
-                Box::new(Proxima::build(t, s, &order(s, m)))
-            },
-        },
-        Entry {
-            name: "UniformGrid3d",
-            peer: false,
-            quadratic: false,
-            build: |s, sc, m| {
-                let t = UniformGrid3d::new(sc.world, sc.r_max).expect("grid params");
-                Box::new(Proxima::build(t, s, &order(s, m)))
-            },
-        },
-        Entry {
-            name: "UniformGrid2d",
-            peer: false,
-            quadratic: false,
-            build: |s, sc, m| {
-                let t = UniformGrid2d::new(sc.world, sc.r_max).expect("grid params");
-                Box::new(Proxima::build(t, s, &order(s, m)))
-            },
-        },
+    // Proxima's indices in the table's order; O(n²) brute force is skipped on
+    // large sets.
+    let ours = [
+        IndexKind::Brute,
+        IndexKind::LooseKd,
+        IndexKind::Octree,
+        IndexKind::HashGrid,
+        IndexKind::Grid3d,
+        IndexKind::Grid2d,
+    ]
+    .map(|kind| Entry {
+        name: kind.type_name(),
+        peer: false,
+        quadratic: kind == IndexKind::Brute,
+        build: Build::Index(kind),
+    });
+    let peers = [
         Entry {
             name: "parry3d",
             peer: true,
             quadratic: false,
-            build: |s, _, _| Box::new(parry_peer::ParryQuery::build(s)),
+            build: Build::Peer(|s, _, _| Box::new(parry_peer::ParryQuery::build(s))),
         },
         Entry {
             name: "rstar",
             peer: true,
             quadratic: false,
-            build: |s, _, _| Box::new(rstar_peer::RstarQuery::build(s)),
+            build: Build::Peer(|s, _, _| Box::new(rstar_peer::RstarQuery::build(s))),
         },
         Entry {
             name: "kiddo",
             peer: true,
             quadratic: false,
-            build: |s, _, _| Box::new(kiddo_peer::KiddoQuery::build(s)),
+            build: Build::Peer(|s, _, _| Box::new(kiddo_peer::KiddoQuery::build(s))),
         },
         Entry {
             name: "bvh",
             peer: true,
             quadratic: false,
-            build: |s, _, _| Box::new(bvh_peer::BvhQuery::build(s)),
+            build: Build::Peer(|s, _, _| Box::new(bvh_peer::BvhQuery::build(s))),
         },
-    ]
+    ];
+    ours.into_iter().chain(peers).collect()
 }
 
 /// One structure on one kind.
@@ -265,7 +254,7 @@ pub fn run(a: &Args) -> (Vec<(QueryKind, Vec<Row>)>, Vec<String>) {
             continue;
         }
         eprintln!("building {} ...", e.name);
-        let (engine, build) = a.clock.time(|| (e.build)(&w.spheres, &scene, a.morton));
+        let (engine, build) = a.clock.time(|| e.build.run(&w.spheres, &scene, a.morton));
         built.push((e, engine, build));
     }
     // times[kind][structure]

@@ -5,9 +5,10 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-/// The registry itself, so the tests always cover every registered index.
+/// The CLI's list of indices (the library's `IndexKind`s), so the tests always
+/// cover every index.
 #[path = "../../src/indices.rs"]
-#[allow(dead_code)]
+#[allow(dead_code, unused_imports)]
 pub mod indices;
 
 /// What a run of the binary gave.

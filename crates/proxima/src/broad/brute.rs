@@ -1,13 +1,14 @@
 //! The brute-force index: a flat list scanned by every query. It is the oracle the
 //! other indices are tested against, and the baseline of the benchmarks.
 
-use crate::arena::{Arena, Handle};
-use crate::broad::{Selection, SpatialIndex};
+use crate::arena::Arena;
+use crate::broad::walk::{walk_methods, Walk};
+use crate::broad::{IndexKind, Selection, SpatialIndex};
 use crate::geom::{overlap, Sphere};
-use crate::Result;
+use crate::{Handle, Result};
 use std::ops::ControlFlow;
 
-/// Stores spheres in an [`Arena`] and answers every query by testing each one.
+/// Stores spheres in a generational arena and answers every query by testing each one.
 ///
 /// Insert, remove and update are O(1); queries are O(n); pairs are O(n²). Its
 /// answers are the definition of right for every other index (same closed tests
@@ -24,7 +25,9 @@ impl<T> Default for BruteForce<T> {
 }
 
 impl<T> BruteForce<T> {
-    /// An empty index.
+    /// An empty index. Brute force has nothing to tune, so it has no config
+    /// struct (the one exception to the constructor pattern of the other
+    /// indices).
     pub fn new() -> Self {
         BruteForce {
             items: Arena::new(),
@@ -64,13 +67,29 @@ impl<T: Send + Sync> SpatialIndex<T> for BruteForce<T> {
         self.items.clear();
     }
 
-    fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
+    fn for_each(&self, f: &mut dyn FnMut(Handle, &Sphere, &T)) {
         for (h, (s, v)) in self.items.iter() {
             f(h, s, v);
         }
     }
 
-    fn visit<Q: Selection + ?Sized>(
+    walk_methods!(T);
+
+    fn validate(&self) -> Result<()> {
+        self.items.validate()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>() + self.items.heap_bytes()
+    }
+
+    fn kind(&self) -> IndexKind {
+        IndexKind::Brute
+    }
+}
+
+impl<T> Walk<T> for BruteForce<T> {
+    fn walk<Q: Selection + ?Sized>(
         &self,
         query: &Q,
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
@@ -83,7 +102,7 @@ impl<T: Send + Sync> SpatialIndex<T> for BruteForce<T> {
         ControlFlow::Continue(())
     }
 
-    fn for_each_pair(
+    fn walk_pairs(
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
@@ -96,14 +115,6 @@ impl<T: Send + Sync> SpatialIndex<T> for BruteForce<T> {
             }
         }
         ControlFlow::Continue(())
-    }
-
-    fn validate(&self) -> Result<()> {
-        self.items.validate()
-    }
-
-    fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>() + self.items.heap_bytes()
     }
 }
 
@@ -138,7 +149,7 @@ impl<T: Send + Sync> super::ParallelPairs<T> for BruteForce<T> {
 #[cfg(all(test, feature = "parallel"))]
 mod parallel_tests {
     use super::*;
-    use crate::broad::ParallelPairs;
+    use crate::broad::{ParallelPairs, SpatialIndexExt};
     use glam::Vec3;
 
     #[test]

@@ -5,15 +5,15 @@
 //! Results are combined rayon-style (`init` / `fold` / `reduce`), so each thread
 //! accumulates into its own value and nothing is shared while pairs are found.
 
-use super::{Handle, Selection, SpatialIndex};
+use super::{Query, SpatialIndex};
 use crate::geom::Sphere;
-use crate::Result;
+use crate::{Handle, Result};
 use rayon::prelude::*;
 use std::ops::ControlFlow;
 
 /// Pair finding split across rayon's threads.
 ///
-/// Implementors report exactly the pairs of [`SpatialIndex::for_each_pair`] — each
+/// Implementors report exactly the pairs of [`SpatialIndex::visit_pairs`] — each
 /// overlapping pair once — but from several threads and in no particular order.
 pub trait ParallelPairs<T: Sync>: SpatialIndex<T> {
     /// Folds every overlapping pair into per-task accumulators made by `init`, then
@@ -51,8 +51,8 @@ pub trait ParallelPairs<T: Sync>: SpatialIndex<T> {
 
 /// Validates every query of a batch, so a batch query fails before any work with
 /// the error of the first bad query (and the index is only read, never changed).
-fn validate_all<Q: Selection + Sync>(queries: &[Q]) -> Result<()> {
-    queries.iter().try_for_each(|q| q.validate())
+fn validate_all<Q: Into<Query> + Copy>(queries: &[Q]) -> Result<()> {
+    queries.iter().try_for_each(|&q| q.into().validate())
 }
 
 /// Number of objects each query selects, `out[i]` for `queries[i]`, the queries
@@ -62,21 +62,21 @@ fn validate_all<Q: Selection + Sync>(queries: &[Q]) -> Result<()> {
 /// numbers are invalid.
 pub fn par_query_counts<T, I, Q>(index: &I, queries: &[Q]) -> Result<Vec<usize>>
 where
-    I: SpatialIndex<T>,
-    Q: Selection + Sync,
+    I: SpatialIndex<T> + ?Sized,
+    Q: Into<Query> + Copy + Sync,
 {
     validate_all(queries)?;
-    Ok(queries
+    queries
         .par_iter()
-        .map(|q| {
+        .map(|&q| {
             let mut n = 0usize;
-            let _ = index.visit(q, |_, _, _| {
+            let _ = index.visit(&q.into(), &mut |_, _, _| {
                 n += 1;
                 ControlFlow::Continue(())
-            });
-            n
+            })?;
+            Ok(n)
         })
-        .collect())
+        .collect()
 }
 
 /// Folds every (query, selected object) of a batch into per-task accumulators made
@@ -93,8 +93,8 @@ pub fn par_visit_batch<T, I, Q, A, Init, F, R>(
     reduce: R,
 ) -> Result<A>
 where
-    I: SpatialIndex<T>,
-    Q: Selection + Sync,
+    I: SpatialIndex<T> + ?Sized,
+    Q: Into<Query> + Copy + Sync,
     A: Send,
     Init: Fn() -> A + Sync + Send,
     F: Fn(A, usize, Handle, &Sphere, &T) -> A + Sync + Send,
@@ -104,10 +104,11 @@ where
     Ok(queries
         .par_iter()
         .enumerate()
-        .fold(&init, |acc, (i, q)| {
+        .fold(&init, |acc, (i, &q)| {
             // `visit` takes an `FnMut`, so the accumulator moves through an Option.
             let mut acc = Some(acc);
-            let _ = index.visit(q, |h, s, v| {
+            // Validated above: the walk cannot fail.
+            let _ = index.visit(&q.into(), &mut |h, s, v| {
                 acc = acc.take().map(|a| fold(a, i, h, s, v));
                 ControlFlow::Continue(())
             });
@@ -119,7 +120,8 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::broad::{BruteForce, HashGrid, LinearOctree, LooseKdTree, OctreeConfig};
+    use crate::broad::{BruteForce, HashGrid, LinearOctree, LooseKdTree};
+    use crate::broad::{LooseKdConfig, SpatialIndexExt};
     use crate::geom::{Aabb, Frustum, Ray};
     use crate::Error;
     use glam::{Mat4, Vec3};
@@ -144,21 +146,20 @@ mod tests {
     }
 
     /// Sequential reference: the per-query handle lists, sorted.
-    fn sequential<T, I: SpatialIndex<T>, Q: Selection>(index: &I, qs: &[Q]) -> Vec<Vec<Handle>> {
+    fn sequential<T, I: SpatialIndex<T>, Q: Into<Query> + Copy>(
+        index: &I,
+        qs: &[Q],
+    ) -> Vec<Vec<Handle>> {
         qs.iter()
-            .map(|q| {
-                let mut v = Vec::new();
-                let _ = index.visit(q, |h, _, _| {
-                    v.push(h);
-                    ControlFlow::Continue(())
-                });
+            .map(|&q| {
+                let mut v = index.query(q).unwrap();
                 v.sort();
                 v
             })
             .collect()
     }
 
-    fn check<I: SpatialIndex<u32>, Q: Selection + Sync>(index: &I, qs: &[Q]) {
+    fn check<I: SpatialIndex<u32>, Q: Into<Query> + Copy + Sync>(index: &I, qs: &[Q]) {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
             .build()
@@ -230,10 +231,14 @@ mod tests {
         let mut brute = BruteForce::new();
         fill(&mut brute);
         batches(&brute);
-        let mut kd = LooseKdTree::new(world, 2.2, 0.25).unwrap();
+        let mut kd = LooseKdTree::with_config(LooseKdConfig {
+            density: 0.25,
+            ..LooseKdConfig::new(world, 2.2)
+        })
+        .unwrap();
         fill(&mut kd);
         batches(&kd);
-        let mut oct = LinearOctree::new(world, OctreeConfig::default()).unwrap();
+        let mut oct = LinearOctree::new(world).unwrap();
         fill(&mut oct);
         batches(&oct);
         let mut grid = HashGrid::new(2.2).unwrap();
@@ -243,7 +248,11 @@ mod tests {
 
     #[test]
     fn a_bad_query_fails_the_batch_before_any_work() {
-        let mut kd = LooseKdTree::new(Aabb::new(Vec3::ZERO, Vec3::ONE), 1.0, 0.25).unwrap();
+        let mut kd = LooseKdTree::with_config(LooseKdConfig {
+            density: 0.25,
+            ..LooseKdConfig::new(Aabb::new(Vec3::ZERO, Vec3::ONE), 1.0)
+        })
+        .unwrap();
         kd.insert(Sphere::new(Vec3::ZERO, 1.0), 0u32).unwrap();
         let qs = [
             Sphere::new(Vec3::ZERO, 1.0),

@@ -1,17 +1,28 @@
 //! Query shapes as selection functions (the `rstar` idea): an index traverses its
 //! nodes with [`Selection::classify_box`] and tests stored spheres with
-//! [`Selection::selects`], so one traversal serves every query shape.
+//! [`Selection::selects`], so one traversal serves every query shape. Internal:
+//! users query with [`Query`](super::Query); the trait is sealed and hidden.
 
 use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
 use crate::Result;
 
-/// A query over stored spheres.
+pub(crate) mod sealed {
+    /// Only the crate implements [`Selection`](super::Selection): its box
+    /// tests and plane masks are the indices' internals, free to change.
+    pub trait Sealed {}
+    impl Sealed for crate::geom::Sphere {}
+    impl Sealed for crate::geom::Aabb {}
+    impl Sealed for crate::geom::Ray {}
+    impl Sealed for crate::geom::Frustum {}
+}
+
+/// A query over stored spheres, as the index walks see it.
 ///
 /// Implementations must be consistent: `classify_box(b)` may say `Outside` only if
 /// no sphere lying inside `b` is selected, and `Inside` only if every sphere lying
 /// inside `b` is selected. Index nodes bound whole spheres (loose bounds), which is
 /// what makes these box answers valid for the spheres below a node.
-pub trait Selection {
+pub trait Selection: sealed::Sealed {
     /// Checks the query's own numbers (finite, non-negative radius, …).
     fn validate(&self) -> Result<()>;
 

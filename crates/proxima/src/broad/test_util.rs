@@ -1,6 +1,6 @@
 //! Test helpers shared by the indices' unit tests (compiled only under `cfg(test)`).
 
-use crate::broad::{BruteForce, RayHit, SpatialIndex};
+use crate::broad::{BruteForce, RayHit, SpatialIndex, SpatialIndexExt};
 use crate::geom::Ray;
 use std::ops::ControlFlow;
 
@@ -19,7 +19,7 @@ fn ids(hits: Vec<RayHit>, index: &impl SpatialIndex<u32>) -> Vec<(u32, u32)> {
 /// `t`, and the same first-hit `t`.
 pub(crate) fn check_ray(index: &impl SpatialIndex<u32>, brute: &BruteForce<u32>, r: &Ray) {
     let mut seen = Vec::new();
-    let _ = index.query(r, |h, _, _| {
+    let _ = index.for_each_in(*r, |h, _, _| {
         seen.push(h);
         ControlFlow::Continue(())
     });

@@ -1,3 +1,5 @@
+//! [`Aabb`]: the closed axis-aligned box (query shape, node bound, 6-DOP).
+
 use crate::error::check_vec3;
 use crate::geom::Sphere;
 use crate::{Error, Result};

@@ -1,3 +1,6 @@
+//! [`Frustum`]: six inward-facing planes (a camera's view volume), and the
+//! [`Relation`] of a volume to such a convex region.
+
 use crate::geom::{Aabb, Plane, Sphere};
 use crate::{Error, Result};
 use glam::Mat4;

@@ -72,7 +72,7 @@ fn f32_margin(d2f: f32, rs2f: f32) -> f32 {
 /// many spheres vectorize. O(1).
 #[allow(clippy::too_many_arguments, clippy::neg_cmp_op_on_partial_ord)]
 #[inline(always)]
-pub fn sphere_sphere_candidate(
+pub(crate) fn sphere_sphere_candidate(
     ax: f32,
     ay: f32,
     az: f32,
@@ -97,7 +97,7 @@ pub fn sphere_sphere_candidate(
 /// [`sphere_sphere`] is `false` for it. The same operations as the scalar
 /// pre-test in each SIMD lane, so the same rounding. O(1).
 #[inline(always)]
-pub fn sphere_sphere_candidates4(x: Vec4, y: Vec4, z: Vec4, r: Vec4, s: &Sphere) -> u32 {
+pub(crate) fn sphere_sphere_candidates4(x: Vec4, y: Vec4, z: Vec4, r: Vec4, s: &Sphere) -> u32 {
     let dx = x - Vec4::splat(s.center.x);
     let dy = y - Vec4::splat(s.center.y);
     let dz = z - Vec4::splat(s.center.z);
@@ -520,7 +520,7 @@ pub fn frustum_sphere(f: &Frustum, s: &Sphere) -> Relation {
 /// the sphere need no test. Exact like [`frustum_sphere`]; with a full mask it
 /// is [`frustum_sphere`]. O(planes in `mask`).
 #[inline]
-pub fn frustum_sphere_masked(f: &Frustum, s: &Sphere, mask: u8) -> Relation {
+pub(crate) fn frustum_sphere_masked(f: &Frustum, s: &Sphere, mask: u8) -> Relation {
     let mut rel = Relation::Inside;
     let c = d3(s.center);
     let r = s.radius as f64;
@@ -570,7 +570,12 @@ pub fn frustum_aabb(f: &Frustum, b: &Aabb, mask: u8) -> (Relation, u8) {
 /// [`frustum_sphere`]. With `centres == loose` this is [`frustum_aabb`]. Exact,
 /// by the same corner sums as [`frustum_aabb`]. O(planes in `mask`).
 #[inline]
-pub fn frustum_aabb_centres(f: &Frustum, centres: &Aabb, loose: &Aabb, mask: u8) -> (Relation, u8) {
+pub(crate) fn frustum_aabb_centres(
+    f: &Frustum,
+    centres: &Aabb,
+    loose: &Aabb,
+    mask: u8,
+) -> (Relation, u8) {
     let (lo, hi) = (d3(loose.min), d3(loose.max));
     let (clo, chi) = (d3(centres.min), d3(centres.max));
     let mut out_mask = 0u8;

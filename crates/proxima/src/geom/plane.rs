@@ -1,3 +1,5 @@
+//! [`Plane`]: an oriented plane, the building block of a frustum.
+
 use glam::{Vec3, Vec4};
 
 /// A plane `normal · p + d = 0`; the positive side (`normal · p + d >= 0`) is "inside".

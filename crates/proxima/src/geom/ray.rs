@@ -1,3 +1,6 @@
+//! [`Ray`] (`origin + t·dir`, `t` in `[0, max_t]`) and [`Segment`] (queried as
+//! the ray [`Segment::to_ray`], `t` in `[0, 1]`).
+
 use crate::error::check_vec3;
 use crate::{Error, Result};
 use glam::Vec3;

@@ -1,3 +1,5 @@
+//! [`Sphere`]: the closed ball every broad-phase index stores.
+
 use crate::error::check_vec3;
 use crate::geom::Aabb;
 use crate::{Error, Result};

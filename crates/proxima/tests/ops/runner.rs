@@ -9,13 +9,13 @@
 //! itself unchanged after an error, and pass `validate()` after every operation.
 
 use proxima::broad::{
-    BruteForce, Handle, HashGrid, LinearOctree, LooseKdTree, OctreeConfig, SpatialIndex,
-    UniformGrid2d, UniformGrid3d,
+    BruteForce, Grid2dConfig, Grid3dConfig, HashGrid, HashGridConfig, LinearOctree, LooseKdConfig,
+    LooseKdTree, OctreeConfig, SpatialIndex, SpatialIndexExt, UniformGrid2d, UniformGrid3d,
 };
 use proxima::geom::{Aabb, Frustum, Plane, Ray, Segment, Sphere};
 use proxima::glam::{Mat4, Vec3};
-use proxima::{Error, Result};
-use std::ops::ControlFlow;
+use proxima::{Error, Handle, Result};
+use std::ops::{ControlFlow, Deref, DerefMut};
 
 /// Reads numbers from the fuzz bytes; past the end every read gives zero.
 pub struct Bytes<'a> {
@@ -84,31 +84,25 @@ fn pick(b: u8, xs: &[f32]) -> f32 {
     xs[b as usize % xs.len()]
 }
 
-/// An object-safe view of `SpatialIndex<u32>` (the trait itself has generic
-/// methods), so every index can sit in one `Vec`.
-pub trait Dyn {
-    fn name(&self) -> &'static str;
-    fn insert(&mut self, s: Sphere, v: u32) -> Result<Handle>;
-    fn remove(&mut self, h: Handle) -> Result<u32>;
-    fn update(&mut self, h: Handle, s: Sphere) -> Result<()>;
-    fn get(&self, h: Handle) -> Result<(Sphere, u32)>;
-    fn get_mut_ok(&mut self, h: Handle) -> Result<u32>;
-    fn len(&self) -> usize;
-    fn clear(&mut self);
-    fn validate(&self) -> Result<()>;
-    fn memory_bytes(&self) -> usize;
-    fn sphere_ids(&self, s: &Sphere) -> Result<Vec<u32>>;
-    fn aabb_ids(&self, b: &Aabb) -> Result<Vec<u32>>;
-    fn frustum_ids(&self, f: &Frustum) -> Result<Vec<u32>>;
-    fn ray_hits(&self, r: &Ray) -> Result<Vec<(u32, u32)>>;
-    fn ray_first(&self, r: &Ray) -> Result<Option<(u32, f32)>>;
-    fn segment_hits(&self, s: &Segment) -> Result<Vec<(u32, u32)>>;
-    fn pairs(&self) -> Vec<(u32, u32)>;
-    fn all(&self) -> Vec<(u32, [u32; 4])>;
-    fn early_stop(&self, s: &Sphere) -> Result<usize>;
+/// An index under test and its name. The trait object dispatches; the methods
+/// below turn answers into comparable values (payload ids, bit patterns).
+pub struct Named {
+    name: &'static str,
+    index: Box<dyn SpatialIndex<u32>>,
 }
 
-struct Named<I>(&'static str, I);
+impl Deref for Named {
+    type Target = dyn SpatialIndex<u32>;
+    fn deref(&self) -> &Self::Target {
+        self.index.as_ref()
+    }
+}
+
+impl DerefMut for Named {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        self.index.as_mut()
+    }
+}
 
 fn ids(r: Result<ControlFlow<()>>, mut v: Vec<u32>) -> Result<Vec<u32>> {
     let _ = r?;
@@ -116,40 +110,25 @@ fn ids(r: Result<ControlFlow<()>>, mut v: Vec<u32>) -> Result<Vec<u32>> {
     Ok(v)
 }
 
-impl<I: SpatialIndex<u32>> Dyn for Named<I> {
+impl Named {
+    fn new(name: &'static str, index: impl SpatialIndex<u32> + 'static) -> Self {
+        Named {
+            name,
+            index: Box::new(index),
+        }
+    }
     fn name(&self) -> &'static str {
-        self.0
-    }
-    fn insert(&mut self, s: Sphere, v: u32) -> Result<Handle> {
-        self.1.insert(s, v)
-    }
-    fn remove(&mut self, h: Handle) -> Result<u32> {
-        self.1.remove(h)
-    }
-    fn update(&mut self, h: Handle, s: Sphere) -> Result<()> {
-        self.1.update(h, s)
+        self.name
     }
     fn get(&self, h: Handle) -> Result<(Sphere, u32)> {
-        self.1.get(h).map(|(s, v)| (s, *v))
+        self.index.get(h).map(|(s, v)| (s, *v))
     }
     fn get_mut_ok(&mut self, h: Handle) -> Result<u32> {
-        self.1.get_mut(h).map(|v| *v)
-    }
-    fn len(&self) -> usize {
-        self.1.len()
-    }
-    fn clear(&mut self) {
-        self.1.clear()
-    }
-    fn validate(&self) -> Result<()> {
-        self.1.validate()
-    }
-    fn memory_bytes(&self) -> usize {
-        self.1.memory_bytes()
+        self.index.get_mut(h).map(|v| *v)
     }
     fn sphere_ids(&self, s: &Sphere) -> Result<Vec<u32>> {
         let mut v = Vec::new();
-        let r = self.1.query_sphere(s, |_, _, &x| {
+        let r = self.index.for_each_in(*s, |_, _, &x| {
             v.push(x);
             ControlFlow::Continue(())
         });
@@ -157,7 +136,7 @@ impl<I: SpatialIndex<u32>> Dyn for Named<I> {
     }
     fn aabb_ids(&self, b: &Aabb) -> Result<Vec<u32>> {
         let mut v = Vec::new();
-        let r = self.1.query_aabb(b, |_, _, &x| {
+        let r = self.index.for_each_in(*b, |_, _, &x| {
             v.push(x);
             ControlFlow::Continue(())
         });
@@ -165,7 +144,7 @@ impl<I: SpatialIndex<u32>> Dyn for Named<I> {
     }
     fn frustum_ids(&self, f: &Frustum) -> Result<Vec<u32>> {
         let mut v = Vec::new();
-        let r = self.1.query_frustum(f, |_, _, &x| {
+        let r = self.index.for_each_in(*f, |_, _, &x| {
             v.push(x);
             ControlFlow::Continue(())
         });
@@ -173,33 +152,23 @@ impl<I: SpatialIndex<u32>> Dyn for Named<I> {
     }
     fn ray_hits(&self, r: &Ray) -> Result<Vec<(u32, u32)>> {
         let mut v: Vec<(u32, u32)> = self
-            .1
+            .index
             .ray_hits(r)?
             .into_iter()
-            .map(|h| (*self.1.get(h.handle).unwrap().1, h.t.to_bits()))
+            .map(|h| (*self.index.get(h.handle).unwrap().1, h.t.to_bits()))
             .collect();
         v.sort_unstable();
         Ok(v)
     }
     fn ray_first(&self, r: &Ray) -> Result<Option<(u32, f32)>> {
         Ok(self
-            .1
+            .index
             .ray_first(r)?
-            .map(|h| (*self.1.get(h.handle).unwrap().1, h.t)))
-    }
-    fn segment_hits(&self, s: &Segment) -> Result<Vec<(u32, u32)>> {
-        let mut v: Vec<(u32, u32)> = self
-            .1
-            .segment_hits(s)?
-            .into_iter()
-            .map(|h| (*self.1.get(h.handle).unwrap().1, h.t.to_bits()))
-            .collect();
-        v.sort_unstable();
-        Ok(v)
+            .map(|h| (*self.index.get(h.handle).unwrap().1, h.t)))
     }
     fn pairs(&self) -> Vec<(u32, u32)> {
         let mut v = Vec::new();
-        let _ = self.1.for_each_pair(|_, &a, _, &b| {
+        let _ = self.index.for_each_pair(|_, &a, _, &b| {
             v.push((a.min(b), a.max(b)));
             ControlFlow::Continue(())
         });
@@ -208,7 +177,7 @@ impl<I: SpatialIndex<u32>> Dyn for Named<I> {
     }
     fn all(&self) -> Vec<(u32, [u32; 4])> {
         let mut v = Vec::new();
-        self.1.for_each(|_, s, &x| {
+        self.index.for_each(&mut |_, s, &x| {
             let c = s.center;
             v.push((
                 x,
@@ -226,7 +195,7 @@ impl<I: SpatialIndex<u32>> Dyn for Named<I> {
     /// Number of objects reported by a sphere query told to stop after the first.
     fn early_stop(&self, s: &Sphere) -> Result<usize> {
         let mut n = 0;
-        let _ = self.1.query_sphere(s, |_, _, _| {
+        let _ = self.index.for_each_in(*s, |_, _, _| {
             n += 1;
             ControlFlow::Break(())
         })?;
@@ -236,8 +205,8 @@ impl<I: SpatialIndex<u32>> Dyn for Named<I> {
 
 /// Builds brute force plus every index whose decoded constructor parameters are
 /// accepted (a rejected constructor must be an `Err`, never a panic).
-pub fn build(b: &mut Bytes) -> Vec<Box<dyn Dyn>> {
-    let mut out: Vec<Box<dyn Dyn>> = vec![Box::new(Named("brute", BruteForce::<u32>::new()))];
+pub fn build(b: &mut Bytes) -> Vec<Named> {
+    let mut out: Vec<Named> = vec![Named::new("brute", BruteForce::<u32>::new())];
     // Mostly a sane world; sometimes decoded (possibly invalid) parameters.
     let sane = b.u8() % 4 != 0;
     let world = if sane {
@@ -252,8 +221,12 @@ pub fn build(b: &mut Bytes) -> Vec<Box<dyn Dyn>> {
         f32::from_bits(b.u32())
     };
     let depth = if sane { 2 + b.u8() % 20 } else { b.u8() };
-    match LooseKdTree::with_max_depth(world, r_max, density, depth) {
-        Ok(t) => out.push(Box::new(Named("loose-kd", t))),
+    match LooseKdTree::with_config(LooseKdConfig {
+        density,
+        max_depth: depth,
+        ..LooseKdConfig::new(world, r_max)
+    }) {
+        Ok(t) => out.push(Named::new("loose-kd", t)),
         Err(e) => check_param_error(&e),
     }
     let cfg = OctreeConfig {
@@ -264,9 +237,10 @@ pub fn build(b: &mut Bytes) -> Vec<Box<dyn Dyn>> {
         } else {
             b.u32()
         },
+        ..OctreeConfig::new(world)
     };
-    match LinearOctree::new(world, cfg) {
-        Ok(t) => out.push(Box::new(Named("octree", t))),
+    match LinearOctree::with_config(cfg) {
+        Ok(t) => out.push(Named::new("octree", t)),
         Err(e) => check_param_error(&e),
     }
     let cell = if sane {
@@ -280,8 +254,11 @@ pub fn build(b: &mut Bytes) -> Vec<Box<dyn Dyn>> {
         (e.x / cell + 1.0) * (e.y / cell + 1.0) <= 65536.0
     };
     if small(cell) || cell.is_nan() || cell <= 0.0 {
-        match UniformGrid2d::with_cell_size(world, cell) {
-            Ok(t) => out.push(Box::new(Named("grid2d", t))),
+        match UniformGrid2d::with_config(Grid2dConfig {
+            world,
+            cell_size: cell,
+        }) {
+            Ok(t) => out.push(Named::new("grid2d", t)),
             Err(e) => check_param_error(&e),
         }
     }
@@ -290,7 +267,7 @@ pub fn build(b: &mut Bytes) -> Vec<Box<dyn Dyn>> {
         || r_max <= 0.0
     {
         match UniformGrid2d::new(world, r_max) {
-            Ok(t) => out.push(Box::new(Named("grid2d-new", t))),
+            Ok(t) => out.push(Named::new("grid2d-new", t)),
             Err(e) => check_param_error(&e),
         }
     }
@@ -300,26 +277,29 @@ pub fn build(b: &mut Bytes) -> Vec<Box<dyn Dyn>> {
         (e.x / cell + 1.0) * (e.y / cell + 1.0) * (e.z / cell + 1.0) <= 262_144.0
     };
     if small3(cell) || cell.is_nan() || cell <= 0.0 {
-        match UniformGrid3d::with_cell_size(world, cell) {
-            Ok(t) => out.push(Box::new(Named("grid3d", t))),
+        match UniformGrid3d::with_config(Grid3dConfig {
+            world,
+            cell_size: cell,
+        }) {
+            Ok(t) => out.push(Named::new("grid3d", t)),
             Err(e) => check_param_error(&e),
         }
     }
     if small3(r_max / 0.49) || r_max.is_nan() || r_max <= 0.0 {
         match UniformGrid3d::new(world, r_max) {
-            Ok(t) => out.push(Box::new(Named("grid3d-new", t))),
+            Ok(t) => out.push(Named::new("grid3d-new", t)),
             Err(e) => check_param_error(&e),
         }
     }
     if std::env::var_os("OPS_DEBUG").is_some() {
         eprintln!("hash grid cell {cell:?}, r_max {r_max:?}");
     }
-    match HashGrid::with_cell_size(cell) {
-        Ok(t) => out.push(Box::new(Named("hashgrid", t))),
+    match HashGrid::with_config(HashGridConfig { cell_size: cell }) {
+        Ok(t) => out.push(Named::new("hashgrid", t)),
         Err(e) => check_param_error(&e),
     }
     match HashGrid::new(r_max) {
-        Ok(t) => out.push(Box::new(Named("hashgrid-new", t))),
+        Ok(t) => out.push(Named::new("hashgrid-new", t)),
         Err(e) => check_param_error(&e),
     }
     out
@@ -374,20 +354,16 @@ fn frustum(b: &mut Bytes) -> Frustum {
 }
 
 /// Asserts that every index gave the same answer as brute force (index 0).
-fn same<R: PartialEq + std::fmt::Debug>(
-    what: &str,
-    idx: &[Box<dyn Dyn>],
-    f: impl Fn(&dyn Dyn) -> R,
-) {
-    let want = f(idx[0].as_ref());
+fn same<R: PartialEq + std::fmt::Debug>(what: &str, idx: &[Named], f: impl Fn(&Named) -> R) {
+    let want = f(&idx[0]);
     for i in &idx[1..] {
-        let got = f(i.as_ref());
+        let got = f(i);
         assert_eq!(got, want, "{what}: {} differs from brute force", i.name());
     }
 }
 
 /// Checks what must hold after every operation.
-fn check(idx: &[Box<dyn Dyn>], live: usize) {
+fn check(idx: &[Named], live: usize) {
     for i in idx {
         if let Err(e) = i.validate() {
             panic!("{}: validate failed: {e}", i.name());
@@ -535,7 +511,7 @@ pub fn run(data: &[u8]) {
                 if debug {
                     eprintln!("  {seg:?}");
                 }
-                same("segment hits", &idx, |i| i.segment_hits(&seg));
+                same("segment hits", &idx, |i| i.ray_hits(&seg.to_ray()));
             }
             13 => same("pairs", &idx, |i| i.pairs()),
             14 => {

@@ -2,9 +2,10 @@
 //! queries run on an index and on `BruteForce` side by side; every answer must be
 //! identical and `validate()` must pass after every operation.
 
-use proxima::broad::{BruteForce, Handle, SpatialIndex};
+use proxima::broad::{BruteForce, SpatialIndex, SpatialIndexExt};
 use proxima::geom::{Aabb, Frustum, Ray, Segment, Sphere};
 use proxima::glam::{vec3, Mat4, Vec3};
+use proxima::Handle;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::collections::HashMap;
@@ -340,14 +341,14 @@ where
         match step % 7 {
             0 => {
                 let q = g.query_sphere();
-                let a = ids(&index, &index.sphere_hits(&q).unwrap());
-                let b = ids(&oracle, &oracle.sphere_hits(&q).unwrap());
+                let a = ids(&index, &index.query(q).unwrap());
+                let b = ids(&oracle, &oracle.query(q).unwrap());
                 assert_eq!(a, b, "{}: sphere query {q:?}", ctx());
             }
             1 => {
                 let q = g.query_aabb();
-                let a = ids(&index, &index.aabb_hits(&q).unwrap());
-                let b = ids(&oracle, &oracle.aabb_hits(&q).unwrap());
+                let a = ids(&index, &index.query(q).unwrap());
+                let b = ids(&oracle, &oracle.query(q).unwrap());
                 assert_eq!(a, b, "{}: aabb query {q:?}", ctx());
             }
             2 | 3 => {
@@ -393,8 +394,8 @@ where
             }
             4 => {
                 let f = g.frustum();
-                let a = ids(&index, &index.frustum_hits(&f).unwrap());
-                let b = ids(&oracle, &oracle.frustum_hits(&f).unwrap());
+                let a = ids(&index, &index.query(f).unwrap());
+                let b = ids(&oracle, &oracle.query(f).unwrap());
                 assert_eq!(a, b, "{}: frustum query", ctx());
             }
             5 => {
@@ -403,7 +404,7 @@ where
                     let big = Sphere::new(g.world.center(), 1e6);
                     let mut n = 0;
                     let r = index
-                        .query_sphere(&big, |_, _, _| {
+                        .for_each_in(big, |_, _, _| {
                             n += 1;
                             ControlFlow::Break(())
                         })

@@ -4,45 +4,98 @@
 mod harness;
 
 use harness::{run, SceneParams, ALL_SCENES};
-use proxima::broad::{BruteForce, HashGrid, LooseKdTree, UniformGrid2d, UniformGrid3d};
+use proxima::broad::{
+    AnyIndex, IndexKind, LinearOctree, LooseKdConfig, LooseKdTree, OctreeConfig, SceneHint,
+    SpatialIndex,
+};
 
 /// Number of random operations per scene and seed.
 const OPS: usize = 6000;
 
-/// One `#[test]` per index: every scene, two seeds each.
+/// The index of `kind` the suite runs: each config's `for_scene`, except a
+/// small-leaf octree and a denser loose k-d tree (more splits, merges and moves
+/// between nodes per operation).
+fn make(kind: IndexKind, p: &SceneParams) -> AnyIndex<u64> {
+    let hint = SceneHint::new(p.world, p.r_max);
+    match kind {
+        IndexKind::Octree => LinearOctree::with_config(OctreeConfig {
+            max_per_leaf: 4,
+            merge_below: 2,
+            max_depth: 12,
+            ..OctreeConfig::for_scene(&hint)
+        })
+        .unwrap()
+        .into(),
+        IndexKind::LooseKd => LooseKdTree::with_config(LooseKdConfig {
+            density: 0.5,
+            ..LooseKdConfig::for_scene(&hint)
+        })
+        .unwrap()
+        .into(),
+        _ => kind.build(&hint).unwrap(),
+    }
+}
+
+/// One `#[test]` per index kind: every scene, two seeds each. `COVERED` lists
+/// the kinds, so that a kind without a suite fails `every_kind_has_a_suite`.
 macro_rules! oracle_suite {
-    ($name:ident, $make:expr) => {
-        #[test]
-        fn $name() {
-            for scene in ALL_SCENES {
-                for seed in [1u64, 2] {
-                    run(scene, seed, OPS, $make);
+    ($($name:ident: $kind:ident),+ $(,)?) => {
+        const COVERED: &[IndexKind] = &[$(IndexKind::$kind),+];
+        $(
+            #[test]
+            fn $name() {
+                for scene in ALL_SCENES {
+                    for seed in [1u64, 2] {
+                        run(scene, seed, OPS, |p| make(IndexKind::$kind, p));
+                    }
                 }
             }
-        }
+        )+
     };
 }
 
 // The oracle against itself still exercises validate(), handles and bad input.
-oracle_suite!(brute_force, |_: &SceneParams| BruteForce::new());
-oracle_suite!(octree, |p: &SceneParams| {
-    let cfg = proxima::broad::OctreeConfig {
-        max_per_leaf: 4,
-        merge_below: 2,
-        max_depth: 12,
-    };
-    proxima::broad::LinearOctree::new(p.world, cfg).unwrap()
-});
-oracle_suite!(loose_kd, |p: &SceneParams| LooseKdTree::new(
-    p.world, p.r_max, 0.5
-)
-.unwrap());
-oracle_suite!(grid2d, |p: &SceneParams| UniformGrid2d::new(
-    p.world, p.r_max
-)
-.unwrap());
-oracle_suite!(hash_grid, |p: &SceneParams| HashGrid::new(p.r_max).unwrap());
-oracle_suite!(grid3d, |p: &SceneParams| UniformGrid3d::new(
-    p.world, p.r_max
-)
-.unwrap());
+oracle_suite!(
+    brute_force: Brute,
+    octree: Octree,
+    loose_kd: LooseKd,
+    grid2d: Grid2d,
+    hash_grid: HashGrid,
+    grid3d: Grid3d,
+);
+
+#[test]
+fn every_kind_has_a_suite() {
+    let mut covered = COVERED.to_vec();
+    covered.sort();
+    assert_eq!(covered, IndexKind::ALL);
+}
+
+/// The index inside `any`, boxed as a trait object of its own type.
+fn boxed(any: AnyIndex<u64>) -> Box<dyn SpatialIndex<u64>> {
+    match any {
+        AnyIndex::Brute(i) => Box::new(i),
+        AnyIndex::LooseKd(i) => Box::new(i),
+        AnyIndex::Octree(i) => Box::new(i),
+        AnyIndex::Grid2d(i) => Box::new(i),
+        AnyIndex::HashGrid(i) => Box::new(i),
+        AnyIndex::Grid3d(i) => Box::new(i),
+        other => panic!("a new kind to box here: {:?}", other.kind()),
+    }
+}
+
+/// Every index behind `Box<dyn SpatialIndex>` (one vtable call per operation,
+/// per reported object and per pair), through the same harness: the trait is
+/// object-safe and the box forwards everything.
+#[test]
+fn every_kind_through_a_box_dyn() {
+    for kind in IndexKind::ALL {
+        for scene in ALL_SCENES {
+            run(scene, 3, OPS / 4, |p| {
+                let index = boxed(make(kind, p));
+                assert_eq!(index.kind(), kind);
+                index
+            });
+        }
+    }
+}

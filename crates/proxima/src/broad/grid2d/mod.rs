@@ -14,16 +14,46 @@ mod query;
 mod ray;
 mod validate;
 
-use crate::arena::{Arena, Handle};
+use crate::arena::Arena;
 use crate::broad::cell_list::{CellList, Reach};
-use crate::broad::{RayHit, Selection, SpatialIndex};
+use crate::broad::walk::{walk_methods, Walk};
+use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
-use crate::{Error, Result};
+use crate::{Error, Handle, Result};
 use cells::{CellRect, Geometry};
 use std::ops::ControlFlow;
 
 /// Default cap on the number of cells chosen by [`UniformGrid2d::new`].
 const DEFAULT_MAX_CELLS: usize = 1 << 20;
+
+/// Everything a [`UniformGrid2d`] is built from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid2dConfig {
+    /// The box whose XY rectangle the cells cover (z is not gridded). Objects
+    /// outside it are referenced from the border cells, still exactly.
+    pub world: Aabb,
+    /// The edge of the square cells: finite and `> 0`, at most 2^16 cells along
+    /// an axis and 2^24 in all.
+    pub cell_size: f32,
+}
+
+impl Grid2dConfig {
+    /// Cells of [`UniformGrid2d::default_cell_size`] for objects of radius up to
+    /// about `typical_radius` (a negative or non-finite radius gives a NaN cell
+    /// size, which the grid rejects).
+    pub fn new(world: Aabb, typical_radius: f32) -> Self {
+        Grid2dConfig {
+            world,
+            cell_size: UniformGrid2d::<()>::cell_for_radius(&world, typical_radius)
+                .unwrap_or(f32::NAN),
+        }
+    }
+
+    /// Cells sized for the hint's `r_max` over its world box.
+    pub fn for_scene(hint: &SceneHint) -> Self {
+        Self::new(hint.world, hint.r_max)
+    }
+}
 
 /// A stored object: the cells it is referenced from and its payload (the sphere
 /// is in the dense `spheres` array).
@@ -86,19 +116,15 @@ impl<T> UniformGrid2d<T> {
     /// Errors on an invalid box or a negative or non-finite radius.
     pub fn new(world: Aabb, typical_radius: f32) -> Result<Self> {
         world.validate()?;
-        if !typical_radius.is_finite() || typical_radius < 0.0 {
-            return Err(Error::InvalidParameter(format!(
-                "typical radius {typical_radius} must be finite and not negative"
-            )));
-        }
-        Self::with_cell_size(world, Self::default_cell_size(&world, typical_radius))
+        let cell_size = Self::cell_for_radius(&world, typical_radius)?;
+        Self::with_config(Grid2dConfig { world, cell_size })
     }
 
-    /// A grid over `world`'s XY rectangle with square cells of edge `cell_size`.
-    /// Errors on an invalid box, a cell size that is not finite and positive, or a
-    /// grid of more than 2^16 cells along an axis or 2^24 cells in all.
-    pub fn with_cell_size(world: Aabb, cell_size: f32) -> Result<Self> {
-        let geom = Geometry::new(&world, cell_size)?;
+    /// A grid as `config` says. Errors on an invalid box, or a cell size that is
+    /// not finite and positive or makes more than 2^16 cells along an axis or
+    /// 2^24 in all.
+    pub fn with_config(config: Grid2dConfig) -> Result<Self> {
+        let geom = Geometry::new(&config.world, config.cell_size)?;
         Ok(UniformGrid2d {
             cells: vec![CellList::default(); geom.cell_count()],
             geom,
@@ -108,6 +134,17 @@ impl<T> UniformGrid2d<T> {
             refs: 0,
             reach: Reach::default(),
         })
+    }
+
+    /// [`UniformGrid2d::default_cell_size`], or the error for a radius that is
+    /// negative or not finite.
+    fn cell_for_radius(world: &Aabb, typical_radius: f32) -> Result<f32> {
+        if !typical_radius.is_finite() || typical_radius < 0.0 {
+            return Err(Error::InvalidParameter(format!(
+                "typical radius {typical_radius} must be finite and not negative"
+            )));
+        }
+        Ok(Self::default_cell_size(world, typical_radius))
     }
 
     /// The default cell edge: twice `typical_radius` (a typical footprint then
@@ -238,13 +275,34 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid2d<T> {
         self.reach = Reach::default();
     }
 
-    fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
+    fn for_each(&self, f: &mut dyn FnMut(Handle, &Sphere, &T)) {
         for (h, i) in self.items.iter() {
             f(h, &self.spheres[h.index() as usize], &i.value);
         }
     }
 
-    fn visit<Q: Selection + ?Sized>(
+    walk_methods!(T);
+
+    fn validate(&self) -> Result<()> {
+        self.check()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.items.heap_bytes()
+            + self.handles.capacity() * std::mem::size_of::<Handle>()
+            + self.spheres.capacity() * std::mem::size_of::<Sphere>()
+            + self.cells.capacity() * std::mem::size_of::<CellList<[u16; 2]>>()
+            + self.cells.iter().map(|c| c.heap_bytes()).sum::<usize>()
+    }
+
+    fn kind(&self) -> IndexKind {
+        IndexKind::Grid2d
+    }
+}
+
+impl<T> Walk<T> for UniformGrid2d<T> {
+    fn walk<Q: Selection + ?Sized>(
         &self,
         query: &Q,
         f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
@@ -259,34 +317,22 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid2d<T> {
         self.visit_rect(query, rect, f)
     }
 
-    fn for_each_pair(
+    fn walk_pairs(
         &self,
         f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        self.visit_pairs(f)
+        self.pair_cells(f)
     }
 
-    fn ray_first_unchecked(&self, ray: &Ray) -> Option<RayHit> {
-        self.first_hit(ray)
-    }
-
-    fn validate(&self) -> Result<()> {
-        self.check()
-    }
-
-    fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + self.items.heap_bytes()
-            + self.handles.capacity() * std::mem::size_of::<Handle>()
-            + self.spheres.capacity() * std::mem::size_of::<Sphere>()
-            + self.cells.capacity() * std::mem::size_of::<CellList<[u16; 2]>>()
-            + self.cells.iter().map(|c| c.heap_bytes()).sum::<usize>()
+    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
+        self.ray_first_cells(ray)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::broad::Grid2dConfig;
     use glam::{vec3, Vec3};
 
     #[test]
@@ -302,7 +348,11 @@ mod tests {
         assert_eq!(g.dims(), [256, 256]);
         assert!(UniformGrid2d::<()>::new(w, -1.0).is_err());
         assert!(UniformGrid2d::<()>::new(w, f32::INFINITY).is_err());
-        assert!(UniformGrid2d::<()>::with_cell_size(w, 0.0).is_err());
+        assert!(UniformGrid2d::<()>::with_config(Grid2dConfig {
+            world: w,
+            cell_size: 0.0
+        })
+        .is_err());
         let bad = Aabb::new(Vec3::ONE, Vec3::ZERO);
         assert!(UniformGrid2d::<()>::new(bad, 1.0).is_err());
     }
@@ -310,7 +360,11 @@ mod tests {
     #[test]
     fn update_within_the_same_cells_touches_no_cell() {
         let w = Aabb::new(Vec3::ZERO, vec3(100.0, 100.0, 1.0));
-        let mut g = UniformGrid2d::with_cell_size(w, 10.0).unwrap();
+        let mut g = UniformGrid2d::with_config(Grid2dConfig {
+            world: w,
+            cell_size: 10.0,
+        })
+        .unwrap();
         let h = g
             .insert(Sphere::new(vec3(15.0, 15.0, 0.0), 1.0), 'a')
             .unwrap();

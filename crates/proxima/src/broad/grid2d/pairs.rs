@@ -1,8 +1,8 @@
 //! All overlapping pairs: within each cell, test every pair of references.
 
 use super::UniformGrid2d;
-use crate::arena::Handle;
 use crate::geom::{overlap, Sphere};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 /// `overlap::sphere_sphere_candidate` on two stored spheres.
@@ -26,7 +26,7 @@ impl<T> UniformGrid2d<T> {
     /// expansion arithmetic, took seconds when the exact test ran in every cell;
     /// the cell rule first doubled W1's pair time by mispredicted branches).
     /// Cost O(Σ k²) pre-filters over cells with `k` references.
-    pub(super) fn visit_pairs(
+    pub(super) fn pair_cells(
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
@@ -59,6 +59,8 @@ impl<T> UniformGrid2d<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::Grid2dConfig;
+    use crate::broad::SpatialIndexExt;
     use crate::broad::{SpatialIndex, UniformGrid2d};
     use crate::geom::{Aabb, Sphere};
     use glam::{vec3, Vec3};
@@ -66,7 +68,11 @@ mod tests {
     #[test]
     fn pairs_sharing_many_cells_are_reported_once() {
         let w = Aabb::new(Vec3::ZERO, vec3(100.0, 100.0, 10.0));
-        let mut g = UniformGrid2d::with_cell_size(w, 2.0).unwrap();
+        let mut g = UniformGrid2d::with_config(Grid2dConfig {
+            world: w,
+            cell_size: 2.0,
+        })
+        .unwrap();
         let a = g
             .insert(Sphere::new(vec3(50.0, 50.0, 5.0), 10.0), 0)
             .unwrap();

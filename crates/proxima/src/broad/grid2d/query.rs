@@ -3,9 +3,9 @@
 
 use super::cells::CellRect;
 use super::UniformGrid2d;
-use crate::arena::Handle;
 use crate::broad::Selection;
 use crate::geom::{Frustum, Relation, Sphere};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 impl<T> UniformGrid2d<T> {
@@ -55,6 +55,8 @@ impl<T> UniformGrid2d<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::Grid2dConfig;
+    use crate::broad::SpatialIndexExt;
     use crate::broad::{SpatialIndex, UniformGrid2d};
     use crate::geom::{Aabb, Sphere};
     use glam::{vec3, Vec3};
@@ -63,7 +65,11 @@ mod tests {
     #[test]
     fn an_object_in_many_cells_is_reported_once() {
         let w = Aabb::new(Vec3::ZERO, vec3(100.0, 100.0, 10.0));
-        let mut g = UniformGrid2d::with_cell_size(w, 5.0).unwrap();
+        let mut g = UniformGrid2d::with_config(Grid2dConfig {
+            world: w,
+            cell_size: 5.0,
+        })
+        .unwrap();
         let big = g
             .insert(Sphere::new(vec3(50.0, 50.0, 5.0), 30.0), 0)
             .unwrap();
@@ -81,7 +87,7 @@ mod tests {
             Sphere::new(vec3(20.0, 50.0, 5.0), 3.0),
         ] {
             let mut seen = Vec::new();
-            let _ = g.query_sphere(&q, |h, _, _| {
+            let _ = g.for_each_in(q, |h, _, _| {
                 seen.push(h);
                 ControlFlow::Continue(())
             });
@@ -98,7 +104,7 @@ mod tests {
             .unwrap()
             .contains(&small));
         let b = Aabb::new(vec3(51.0, 51.0, 0.0), vec3(53.0, 53.0, 10.0));
-        let mut hits = g.aabb_hits(&b).unwrap();
+        let mut hits = g.query(b).unwrap();
         hits.sort();
         assert_eq!(hits, {
             let mut v = vec![big, small];

@@ -18,10 +18,10 @@
 //! rectangle query over the cells of its (padded) XY point.
 
 use super::UniformGrid2d;
-use crate::arena::Handle;
 use crate::broad::cell_list::CellEntry;
 use crate::broad::RayHit;
 use crate::geom::{overlap, Aabb, Ray, Sphere};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 /// Relative padding of the ray's `b` coordinate (rounding of `o + d t`).
@@ -173,19 +173,12 @@ impl<T> UniformGrid2d<T> {
 
     /// The first hit (smallest `t`, ties by handle), walking front to back and
     /// stopping once a hit precedes the start of the strip just finished.
-    pub(super) fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
+    pub(super) fn ray_first_cells(&self, ray: &Ray) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
         let _ = self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
                 if let Some(t) = overlap::ray_sphere(ray, &self.spheres[e.slot as usize]) {
-                    let h = self.handles[e.slot as usize];
-                    let better = match best {
-                        None => true,
-                        Some(b) => (t, h) < (b.t, b.handle),
-                    };
-                    if better {
-                        best = Some(RayHit { handle: h, t });
-                    }
+                    RayHit::offer(&mut best, t, self.handles[e.slot as usize]);
                 }
                 ControlFlow::Continue(())
             }
@@ -200,13 +193,18 @@ impl<T> UniformGrid2d<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::Grid2dConfig;
     use crate::broad::{BruteForce, SpatialIndex, UniformGrid2d};
     use crate::geom::{Aabb, Ray, Segment, Sphere};
     use glam::{vec3, Vec3};
 
     fn sample() -> (UniformGrid2d<u32>, BruteForce<u32>) {
         let w = Aabb::new(Vec3::ZERO, vec3(100.0, 100.0, 10.0));
-        let mut g = UniformGrid2d::with_cell_size(w, 7.0).unwrap();
+        let mut g = UniformGrid2d::with_config(Grid2dConfig {
+            world: w,
+            cell_size: 7.0,
+        })
+        .unwrap();
         let mut b = BruteForce::new();
         let mut k = 0u32;
         for x in (0..=100).step_by(9) {

@@ -13,12 +13,41 @@ mod par_pairs;
 mod query;
 mod validate;
 
-use crate::arena::{Arena, Handle};
-use crate::broad::{Selection, SpatialIndex};
+use crate::arena::Arena;
+use crate::broad::walk::{walk_methods, Walk};
+use crate::broad::{IndexKind, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Sphere};
-use crate::{Error, Result};
+use crate::{Error, Handle, Result};
 use cells::{CellStore, Geometry, NO_CELL};
 use std::ops::ControlFlow;
+
+/// Everything a [`UniformGrid3d`] is built from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid3dConfig {
+    /// The box the cells cover. Centres outside it are clamped to the border
+    /// cells, still exactly.
+    pub world: Aabb,
+    /// The edge of the cubic cells: finite and `> 0`. The grid enlarges it if
+    /// needed to stay within 2^21 cells, 2^12 along an axis.
+    pub cell_size: f32,
+}
+
+impl Grid3dConfig {
+    /// Cells `typical_radius / 0.49` wide (about twice the radius, so objects up
+    /// to that radius are gridded); a radius that is not finite and positive
+    /// gives a NaN cell size, which the grid rejects.
+    pub fn new(world: Aabb, typical_radius: f32) -> Self {
+        Grid3dConfig {
+            world,
+            cell_size: UniformGrid3d::<()>::cell_for_radius(typical_radius).unwrap_or(f32::NAN),
+        }
+    }
+
+    /// Cells sized for the hint's `r_max` over its world box.
+    pub fn for_scene(hint: &SceneHint) -> Self {
+        Self::new(hint.world, hint.r_max)
+    }
+}
 
 /// Where an object is stored: position `idx` of cell `cell`, or position `idx` of
 /// the large list when `cell == NO_CELL`.
@@ -90,19 +119,14 @@ impl<T> UniformGrid3d<T> {
     /// the caps. Errors on an invalid box or a radius that is not finite and
     /// positive.
     pub fn new(world: Aabb, typical_radius: f32) -> Result<Self> {
-        if !typical_radius.is_finite() || typical_radius <= 0.0 {
-            return Err(Error::InvalidParameter(format!(
-                "typical radius {typical_radius} must be finite and positive"
-            )));
-        }
-        Self::with_cell_size(world, (typical_radius / cells::GRID_FRACTION).min(f32::MAX))
+        let cell_size = Self::cell_for_radius(typical_radius)?;
+        Self::with_config(Grid3dConfig { world, cell_size })
     }
 
-    /// A grid over `world` with cubic cells of edge `cell_size` (or larger, if the
-    /// caps require). Errors on an invalid box or a cell size that is not finite
-    /// and positive.
-    pub fn with_cell_size(world: Aabb, cell_size: f32) -> Result<Self> {
-        let geom = Geometry::new(&world, cell_size)?;
+    /// A grid as `config` says (cells enlarged if the caps require). Errors on
+    /// an invalid box or a cell size that is not finite and positive.
+    pub fn with_config(config: Grid3dConfig) -> Result<Self> {
+        let geom = Geometry::new(&config.world, config.cell_size)?;
         Ok(UniformGrid3d {
             store: CellStore::new(geom.cell_count()),
             geom,
@@ -112,6 +136,17 @@ impl<T> UniformGrid3d<T> {
             large: Vec::new(),
             extent: Aabb::EMPTY,
         })
+    }
+
+    /// `typical_radius / 0.49`, or the error for a radius that is not finite
+    /// and positive.
+    fn cell_for_radius(typical_radius: f32) -> Result<f32> {
+        if !typical_radius.is_finite() || typical_radius <= 0.0 {
+            return Err(Error::InvalidParameter(format!(
+                "typical radius {typical_radius} must be finite and positive"
+            )));
+        }
+        Ok((typical_radius / cells::GRID_FRACTION).min(f32::MAX))
     }
 
     /// Edge of a cell.
@@ -256,13 +291,34 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
         };
     }
 
-    fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
+    fn for_each(&self, f: &mut dyn FnMut(Handle, &Sphere, &T)) {
         for (h, v) in self.items.iter() {
             f(h, &self.spheres[h.index() as usize], v);
         }
     }
 
-    fn visit<Q: Selection + ?Sized>(
+    walk_methods!(T);
+
+    fn validate(&self) -> Result<()> {
+        self.check()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.store.heap_bytes()
+            + self.items.heap_bytes()
+            + self.locs.capacity() * std::mem::size_of::<Loc>()
+            + self.large.capacity() * 4
+            + self.spheres.capacity() * std::mem::size_of::<Sphere>()
+    }
+
+    fn kind(&self) -> IndexKind {
+        IndexKind::Grid3d
+    }
+}
+
+impl<T> Walk<T> for UniformGrid3d<T> {
+    fn walk<Q: Selection + ?Sized>(
         &self,
         query: &Q,
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
@@ -288,34 +344,23 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
         ControlFlow::Continue(())
     }
 
-    fn for_each_pair(
+    fn walk_pairs(
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        self.visit_pairs(0, self.row_count(), &mut f)?;
+        self.pair_rows(0, self.row_count(), &mut f)?;
         for i in 0..self.large.len() {
             self.large_pairs(i, &mut f)?;
         }
         ControlFlow::Continue(())
-    }
-
-    fn validate(&self) -> Result<()> {
-        self.check()
-    }
-
-    fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + self.store.heap_bytes()
-            + self.items.heap_bytes()
-            + self.locs.capacity() * std::mem::size_of::<Loc>()
-            + self.large.capacity() * 4
-            + self.spheres.capacity() * std::mem::size_of::<Sphere>()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::broad::Grid3dConfig;
+    use crate::broad::SpatialIndexExt;
     use glam::{vec3, Vec3};
 
     #[test]
@@ -326,7 +371,11 @@ mod tests {
         assert_eq!(g.dims(), [25, 25, 25]);
         assert!(UniformGrid3d::<()>::new(w, 0.0).is_err());
         assert!(UniformGrid3d::<()>::new(w, f32::NAN).is_err());
-        assert!(UniformGrid3d::<()>::with_cell_size(w, -1.0).is_err());
+        assert!(UniformGrid3d::<()>::with_config(Grid3dConfig {
+            world: w,
+            cell_size: -1.0
+        })
+        .is_err());
         let bad = Aabb::new(Vec3::ONE, Vec3::ZERO);
         assert!(UniformGrid3d::<()>::new(bad, 1.0).is_err());
     }
@@ -334,7 +383,11 @@ mod tests {
     #[test]
     fn objects_move_between_cells_and_the_large_list() {
         let w = Aabb::new(Vec3::ZERO, Vec3::splat(40.0));
-        let mut g = UniformGrid3d::with_cell_size(w, 4.0).unwrap();
+        let mut g = UniformGrid3d::with_config(Grid3dConfig {
+            world: w,
+            cell_size: 4.0,
+        })
+        .unwrap();
         let a = g
             .insert(Sphere::new(vec3(2.0, 2.0, 2.0), 1.0), 'a')
             .unwrap();

@@ -10,8 +10,8 @@
 
 use super::cells::INLINE;
 use super::UniformGrid3d;
-use crate::arena::Handle;
 use crate::geom::{overlap, Sphere};
+use crate::Handle;
 use glam::Vec4;
 use std::ops::ControlFlow;
 
@@ -219,7 +219,7 @@ impl Ring {
 }
 
 impl<T> UniformGrid3d<T> {
-    /// Number of rows of cells (`ny · nz`): the units [`Self::visit_pairs`]
+    /// Number of rows of cells (`ny · nz`): the units [`Self::pair_rows`]
     /// splits on.
     pub(super) fn row_count(&self) -> u32 {
         self.geom.dims[1] * self.geom.dims[2]
@@ -238,7 +238,7 @@ impl<T> UniformGrid3d<T> {
     /// ([`overlap::sphere_sphere_candidates4`]); what it keeps is decided by
     /// [`overlap::sphere_sphere`]. Cost O(cells in the rows and one layer beyond
     /// + Σ k·k'), streaming through the cell arrays in memory order.
-    pub(super) fn visit_pairs(
+    pub(super) fn pair_rows(
         &self,
         w0: u32,
         w1: u32,
@@ -363,6 +363,8 @@ impl<T> UniformGrid3d<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::Grid3dConfig;
+    use crate::broad::SpatialIndexExt;
     use crate::broad::{BruteForce, SpatialIndex, UniformGrid3d};
     use crate::geom::{Aabb, Sphere};
     use glam::{vec3, Vec3};
@@ -371,7 +373,11 @@ mod tests {
     #[test]
     fn pairs_match_brute_force_in_a_crowded_scene() {
         let w = Aabb::new(Vec3::ZERO, Vec3::splat(20.0));
-        let mut g = UniformGrid3d::with_cell_size(w, 4.0).unwrap();
+        let mut g = UniformGrid3d::with_config(Grid3dConfig {
+            world: w,
+            cell_size: 4.0,
+        })
+        .unwrap();
         let mut b = BruteForce::new();
         let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
         for i in 0..600u32 {
@@ -392,7 +398,7 @@ mod tests {
         }
         g.validate().unwrap();
         assert!(g.large_count() > 0 && !g.store.spill.is_empty());
-        let ids = |p: Vec<(crate::arena::Handle, crate::arena::Handle)>, i: &dyn Fn(_) -> u32| {
+        let ids = |p: Vec<(crate::Handle, crate::Handle)>, i: &dyn Fn(_) -> u32| {
             let mut v: Vec<_> = p
                 .into_iter()
                 .map(|(x, y)| (i(x).min(i(y)), i(x).max(i(y))))
@@ -409,7 +415,7 @@ mod tests {
 
 #[cfg(test)]
 mod row_scan_tests {
-    use crate::broad::{BruteForce, SpatialIndex, UniformGrid3d};
+    use crate::broad::{BruteForce, Grid3dConfig, SpatialIndex, SpatialIndexExt, UniformGrid3d};
     use crate::geom::{Aabb, Sphere};
     use glam::{vec3, Vec3};
     use rand::{Rng, SeedableRng};
@@ -447,7 +453,11 @@ mod row_scan_tests {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(2024);
         for (si, &ext) in shapes.iter().enumerate() {
             let world = Aabb::new(Vec3::ZERO, ext);
-            let mut g = UniformGrid3d::with_cell_size(world, 4.0).unwrap();
+            let mut g = UniformGrid3d::with_config(Grid3dConfig {
+                world,
+                cell_size: 4.0,
+            })
+            .unwrap();
             let mut b = BruteForce::new();
             let mut live = Vec::new();
             let draw = |rng: &mut rand_pcg::Pcg64, crowd: bool| {

@@ -24,7 +24,7 @@ impl<T: Send + Sync> ParallelPairs<T> for UniformGrid3d<T> {
     where
         A: Send,
         I: Fn() -> A + Sync + Send,
-        F: Fn(A, crate::broad::Handle, &T, crate::broad::Handle, &T) -> A + Sync + Send,
+        F: Fn(A, crate::Handle, &T, crate::Handle, &T) -> A + Sync + Send,
         R: Fn(A, A) -> A + Sync + Send,
     {
         let rows = self.row_count();
@@ -41,7 +41,7 @@ impl<T: Send + Sync> ParallelPairs<T> for UniformGrid3d<T> {
                 let w0 = t * per_task;
                 let w1 = (w0 + per_task).min(rows);
                 let mut acc = Some(acc);
-                let _ = self.visit_pairs(w0, w1, &mut |ha, va, hb, vb| {
+                let _ = self.pair_rows(w0, w1, &mut |ha, va, hb, vb| {
                     acc = acc.take().map(|a| fold(a, ha, va, hb, vb));
                     ControlFlow::Continue(())
                 });
@@ -65,6 +65,8 @@ impl<T: Send + Sync> ParallelPairs<T> for UniformGrid3d<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::Grid3dConfig;
+    use crate::broad::SpatialIndexExt;
     use crate::broad::{BruteForce, ParallelPairs, SpatialIndex, UniformGrid3d};
     use crate::geom::{Aabb, Sphere};
     use glam::{vec3, Vec3};
@@ -73,7 +75,11 @@ mod tests {
     #[test]
     fn parallel_pairs_equal_sequential_and_brute_force() {
         let w = Aabb::new(Vec3::ZERO, Vec3::splat(60.0));
-        let mut g = UniformGrid3d::with_cell_size(w, 4.0).unwrap();
+        let mut g = UniformGrid3d::with_config(Grid3dConfig {
+            world: w,
+            cell_size: 4.0,
+        })
+        .unwrap();
         let mut b = BruteForce::new();
         let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
         let mut handles = Vec::new();
@@ -97,8 +103,7 @@ mod tests {
             .num_threads(2)
             .build()
             .unwrap();
-        let to_ids = |p: Vec<(crate::arena::Handle, crate::arena::Handle)>,
-                      idx: &dyn SpatialIndexIds| {
+        let to_ids = |p: Vec<(crate::Handle, crate::Handle)>, idx: &dyn SpatialIndexIds| {
             let mut v: Vec<(u32, u32)> = p
                 .into_iter()
                 .map(|(x, y)| {
@@ -131,10 +136,10 @@ mod tests {
 
     /// Payload id of a handle, for comparing indices with different handles.
     trait SpatialIndexIds {
-        fn id(&self, h: crate::arena::Handle) -> u32;
+        fn id(&self, h: crate::Handle) -> u32;
     }
     impl<I: SpatialIndex<u32>> SpatialIndexIds for I {
-        fn id(&self, h: crate::arena::Handle) -> u32 {
+        fn id(&self, h: crate::Handle) -> u32 {
             *self.get(h).unwrap().1
         }
     }

@@ -2,9 +2,9 @@
 //! of every selected gridded object, each cell once (so each object once).
 
 use super::UniformGrid3d;
-use crate::arena::Handle;
 use crate::broad::Selection;
 use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 /// Ranges of at most this many cells are visited row by row without the block
@@ -244,6 +244,9 @@ impl<T> UniformGrid3d<T> {
 #[cfg(test)]
 mod tests {
     use crate::broad::test_util::check_ray;
+    use crate::broad::walk::Walk;
+    use crate::broad::Grid3dConfig;
+    use crate::broad::SpatialIndexExt;
     use crate::broad::{BruteForce, SpatialIndex, UniformGrid3d};
     use crate::geom::{Aabb, Frustum, Plane, Ray, Sphere};
     use glam::{vec3, Mat4, Vec3};
@@ -251,7 +254,7 @@ mod tests {
     use std::ops::ControlFlow;
 
     /// Payload ids of `hits`, sorted.
-    fn ids<I: SpatialIndex<u32>>(index: &I, hits: Vec<crate::arena::Handle>) -> Vec<u32> {
+    fn ids<I: SpatialIndex<u32>>(index: &I, hits: Vec<crate::Handle>) -> Vec<u32> {
         let mut v: Vec<u32> = hits.iter().map(|h| *index.get(*h).unwrap().1).collect();
         v.sort_unstable();
         v
@@ -329,7 +332,11 @@ mod tests {
         ];
         for (ext, cell) in shapes {
             let w = Aabb::new(Vec3::ZERO, ext);
-            let mut g = UniformGrid3d::with_cell_size(w, cell).unwrap();
+            let mut g = UniformGrid3d::with_config(Grid3dConfig {
+                world: w,
+                cell_size: cell,
+            })
+            .unwrap();
             let mut b = BruteForce::new();
             let lim = 0.49 * g.cell_size();
             for i in 0..600u32 {
@@ -352,23 +359,23 @@ mod tests {
             for k in 0..150 {
                 let fr = rand_frustum(&mut rng);
                 assert_eq!(
-                    ids(&g, g.frustum_hits(&fr).unwrap()),
-                    ids(&b, b.frustum_hits(&fr).unwrap()),
+                    ids(&g, g.query(fr).unwrap()),
+                    ids(&b, b.query(fr).unwrap()),
                     "{fr:?}"
                 );
                 let scale = [0.01, 1.0, 5.0, 20.0, 200.0][k % 5];
                 let q = Sphere::new(rand_vec(&mut rng, -15.0, 45.0), rng.gen_range(0.0..scale));
                 assert_eq!(
-                    ids(&g, g.sphere_hits(&q).unwrap()),
-                    ids(&b, b.sphere_hits(&q).unwrap()),
+                    ids(&g, g.query(q).unwrap()),
+                    ids(&b, b.query(q).unwrap()),
                     "{q:?}"
                 );
                 let c = rand_vec(&mut rng, -15.0, 45.0);
                 let h = rand_vec(&mut rng, 0.0, scale);
                 let q = Aabb::new(c - h, c + h);
                 assert_eq!(
-                    ids(&g, g.aabb_hits(&q).unwrap()),
-                    ids(&b, b.aabb_hits(&q).unwrap()),
+                    ids(&g, g.query(q).unwrap()),
+                    ids(&b, b.query(q).unwrap()),
                     "{q:?}"
                 );
             }
@@ -379,7 +386,11 @@ mod tests {
     #[test]
     fn block_descent_stops_early() {
         let w = Aabb::new(Vec3::ZERO, Vec3::splat(30.0));
-        let mut g = UniformGrid3d::with_cell_size(w, 3.0).unwrap();
+        let mut g = UniformGrid3d::with_config(Grid3dConfig {
+            world: w,
+            cell_size: 3.0,
+        })
+        .unwrap();
         for i in 0..500u32 {
             let c = vec3(
                 (i % 10) as f32 * 3.0,
@@ -391,7 +402,7 @@ mod tests {
         let big = Sphere::new(Vec3::splat(15.0), 100.0);
         for stop in [1, 7, 499] {
             let mut n = 0;
-            let r = g.visit(&big, |_, _, _| {
+            let r = g.walk(&big, |_, _, _| {
                 n += 1;
                 if n == stop {
                     ControlFlow::Break(())
@@ -406,7 +417,11 @@ mod tests {
     #[test]
     fn rays_and_ranges_match_brute_force() {
         let w = Aabb::new(Vec3::ZERO, Vec3::splat(30.0));
-        let mut g = UniformGrid3d::with_cell_size(w, 3.0).unwrap();
+        let mut g = UniformGrid3d::with_config(Grid3dConfig {
+            world: w,
+            cell_size: 3.0,
+        })
+        .unwrap();
         let mut b = BruteForce::new();
         let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
         for i in 0..400u32 {
@@ -447,9 +462,9 @@ mod tests {
             };
             check_ray(&g, &b, &Ray::with_max_t(o, d, t));
             let q = Sphere::new(o, rng.gen_range(0.0..8.0));
-            let mut hg = g.sphere_hits(&q).unwrap();
+            let mut hg = g.query(q).unwrap();
             let mut hb: Vec<u32> = b
-                .sphere_hits(&q)
+                .query(q)
                 .unwrap()
                 .iter()
                 .map(|h| *b.get(*h).unwrap().1)

@@ -13,11 +13,12 @@ mod query;
 mod ray;
 mod validate;
 
-use crate::arena::{Arena, Handle};
+use crate::arena::Arena;
 use crate::broad::cell_list::{CellList, Reach};
-use crate::broad::{RayHit, Selection, SpatialIndex};
+use crate::broad::walk::{walk_methods, Walk};
+use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
-use crate::{Error, Result};
+use crate::{Error, Handle, Result};
 use keys::{Key, KeyBox, Keys};
 use rustc_hash::FxHashMap;
 use std::ops::ControlFlow;
@@ -25,6 +26,28 @@ use std::ops::ControlFlow;
 /// Objects whose bounding box covers more cells than this are kept in the
 /// oversized list instead of the cells.
 const MAX_CELLS_PER_OBJECT: u64 = 64;
+
+/// Everything a [`HashGrid`] is built from (it needs no world box).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HashGridConfig {
+    /// The edge of the cubic cells: finite and `> 0`, with a finite inverse.
+    pub cell_size: f32,
+}
+
+impl HashGridConfig {
+    /// Cells twice `typical_radius` wide (a radius that is not finite and
+    /// positive gives a NaN cell size, which the grid rejects).
+    pub fn new(typical_radius: f32) -> Self {
+        HashGridConfig {
+            cell_size: HashGrid::<()>::cell_for_radius(typical_radius).unwrap_or(f32::NAN),
+        }
+    }
+
+    /// Cells twice the hint's `r_max` wide.
+    pub fn for_scene(hint: &SceneHint) -> Self {
+        Self::new(hint.r_max)
+    }
+}
 
 /// Where an object is referenced from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -135,24 +158,32 @@ impl<T> HashGrid<T> {
     /// covers at most 2 × 2 × 2 cells). Errors unless the radius is finite and
     /// positive.
     pub fn new(typical_radius: f32) -> Result<Self> {
-        if !typical_radius.is_finite() || typical_radius <= 0.0 {
-            return Err(Error::InvalidParameter(format!(
-                "typical radius {typical_radius} must be finite and positive"
-            )));
-        }
-        // `2 r` overflows above f32::MAX / 2: the largest cell then.
-        Self::with_cell_size((2.0 * typical_radius).min(f32::MAX))
+        let cell_size = Self::cell_for_radius(typical_radius)?;
+        Self::with_config(HashGridConfig { cell_size })
     }
 
-    /// A grid with cubic cells of edge `cell_size`. Errors unless it is finite,
-    /// positive and has a finite inverse.
-    pub fn with_cell_size(cell_size: f32) -> Result<Self> {
+    /// A grid as `config` says. Errors unless the cell size is finite and
+    /// positive with a finite inverse.
+    pub fn with_config(config: HashGridConfig) -> Result<Self> {
+        let cell_size = config.cell_size;
         if !cell_size.is_finite() || cell_size <= 0.0 || !(1.0 / cell_size).is_finite() {
             return Err(Error::InvalidParameter(format!(
                 "hash grid cell size {cell_size} must be finite and positive"
             )));
         }
         Ok(HashGrid::empty(Keys::new(cell_size)))
+    }
+
+    /// Twice `typical_radius`, or the error for a radius that is not finite and
+    /// positive.
+    fn cell_for_radius(typical_radius: f32) -> Result<f32> {
+        if !typical_radius.is_finite() || typical_radius <= 0.0 {
+            return Err(Error::InvalidParameter(format!(
+                "typical radius {typical_radius} must be finite and positive"
+            )));
+        }
+        // `2 r` overflows above f32::MAX / 2: the largest cell then.
+        Ok((2.0 * typical_radius).min(f32::MAX))
     }
 
     /// Edge of a cell.
@@ -300,46 +331,13 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
         *self = HashGrid::empty(keys);
     }
 
-    fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
+    fn for_each(&self, f: &mut dyn FnMut(Handle, &Sphere, &T)) {
         for (h, i) in self.items.iter() {
             f(h, &self.spheres[h.index() as usize], &i.value);
         }
     }
 
-    fn visit<Q: Selection + ?Sized>(
-        &self,
-        query: &Q,
-        mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
-    ) -> ControlFlow<()> {
-        if let Some(ray) = query.as_ray() {
-            self.visit_ray(ray, &mut f)?;
-        } else {
-            let kb = match query.bounds() {
-                Some(b) => self.keys.aabb_box(&b),
-                None => KeyBox::ALL,
-            };
-            self.visit_cells(query, kb, &mut f)?;
-        }
-        for &slot in &self.oversized {
-            let s = &self.spheres[slot as usize];
-            if query.selects(s) {
-                let (h, v) = self.resolve(slot);
-                f(h, s, v)?;
-            }
-        }
-        ControlFlow::Continue(())
-    }
-
-    fn for_each_pair(
-        &self,
-        f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
-    ) -> ControlFlow<()> {
-        self.visit_pairs(f)
-    }
-
-    fn ray_first_unchecked(&self, ray: &Ray) -> Option<RayHit> {
-        self.first_hit(ray)
-    }
+    walk_methods!(T);
 
     fn validate(&self) -> Result<()> {
         self.check()
@@ -363,11 +361,54 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
             + self.spheres.capacity() * std::mem::size_of::<Sphere>()
             + self.oversized.capacity() * 4
     }
+
+    fn kind(&self) -> IndexKind {
+        IndexKind::HashGrid
+    }
+}
+
+impl<T> Walk<T> for HashGrid<T> {
+    fn walk<Q: Selection + ?Sized>(
+        &self,
+        query: &Q,
+        mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        if let Some(ray) = query.as_ray() {
+            self.visit_ray(ray, &mut f)?;
+        } else {
+            let kb = match query.bounds() {
+                Some(b) => self.keys.aabb_box(&b),
+                None => KeyBox::ALL,
+            };
+            self.visit_cells(query, kb, &mut f)?;
+        }
+        for &slot in &self.oversized {
+            let s = &self.spheres[slot as usize];
+            if query.selects(s) {
+                let (h, v) = self.resolve(slot);
+                f(h, s, v)?;
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    fn walk_pairs(
+        &self,
+        f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        self.pair_cells(f)
+    }
+
+    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
+        self.ray_first_cells(ray)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::broad::HashGridConfig;
+    use crate::broad::SpatialIndexExt;
     use glam::{vec3, Vec3};
 
     #[test]
@@ -376,13 +417,16 @@ mod tests {
         assert!(HashGrid::<()>::new(0.0).is_err());
         assert!(HashGrid::<()>::new(-1.0).is_err());
         assert!(HashGrid::<()>::new(f32::NAN).is_err());
-        assert!(HashGrid::<()>::with_cell_size(f32::INFINITY).is_err());
-        assert!(HashGrid::<()>::with_cell_size(1e-45).is_err());
+        assert!(HashGrid::<()>::with_config(HashGridConfig {
+            cell_size: f32::INFINITY
+        })
+        .is_err());
+        assert!(HashGrid::<()>::with_config(HashGridConfig { cell_size: 1e-45 }).is_err());
     }
 
     #[test]
     fn objects_move_between_cells_and_the_oversized_list() {
-        let mut g = HashGrid::with_cell_size(4.0).unwrap();
+        let mut g = HashGrid::with_config(HashGridConfig { cell_size: 4.0 }).unwrap();
         let h = g
             .insert(Sphere::new(vec3(2.0, 2.0, 2.0), 1.0), 'a')
             .unwrap();

@@ -2,8 +2,8 @@
 
 use super::keys::KeyBox;
 use super::HashGrid;
-use crate::arena::Handle;
 use crate::geom::{overlap, Sphere};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 /// `overlap::sphere_sphere_candidate` on two stored spheres.
@@ -24,7 +24,7 @@ impl<T> HashGrid<T> {
     /// oversized object against the others after it in the list, then a grid query
     /// with its sphere (each gridded object once, by the query's own rule). Cost
     /// O(Σ k² + oversized² + oversized × query).
-    pub(super) fn visit_pairs(
+    pub(super) fn pair_cells(
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
@@ -69,13 +69,15 @@ impl<T> HashGrid<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::HashGridConfig;
+    use crate::broad::SpatialIndexExt;
     use crate::broad::{HashGrid, SpatialIndex};
     use crate::geom::Sphere;
     use glam::{vec3, Vec3};
 
     #[test]
     fn pairs_are_reported_once() {
-        let mut g = HashGrid::with_cell_size(1.0).unwrap();
+        let mut g = HashGrid::with_config(HashGridConfig { cell_size: 1.0 }).unwrap();
         // Two spheres sharing 3 x 3 x 3 cells (most of their 27 and 64).
         let a = g.insert(Sphere::new(Vec3::splat(5.0), 1.2), 0).unwrap();
         let b = g.insert(Sphere::new(Vec3::splat(5.5), 1.4), 1).unwrap();

@@ -2,10 +2,10 @@
 
 use super::keys::{Key, KeyBox};
 use super::HashGrid;
-use crate::arena::Handle;
 use crate::broad::cell_list::CellList;
 use crate::broad::Selection;
 use crate::geom::{Frustum, Relation, Sphere};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 impl<T> HashGrid<T> {
@@ -82,6 +82,8 @@ impl<T> HashGrid<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::HashGridConfig;
+    use crate::broad::SpatialIndexExt;
     use crate::broad::{BruteForce, HashGrid, SpatialIndex};
     use crate::geom::{Aabb, Sphere};
     use glam::{vec3, Vec3};
@@ -90,7 +92,7 @@ mod tests {
     /// Sorted payloads of the objects `q` selects (duplicates kept).
     fn values(i: &impl SpatialIndex<u32>, q: &Sphere) -> Vec<u32> {
         let mut v = Vec::new();
-        let _ = i.query_sphere(q, |_, _, x| {
+        let _ = i.for_each_in(*q, |_, _, x| {
             v.push(*x);
             ControlFlow::Continue(())
         });
@@ -100,7 +102,7 @@ mod tests {
 
     #[test]
     fn huge_and_unbounded_queries_are_exact_and_once() {
-        let mut g = HashGrid::with_cell_size(2.0).unwrap();
+        let mut g = HashGrid::with_config(HashGridConfig { cell_size: 2.0 }).unwrap();
         let mut b = BruteForce::new();
         let mut k = 0;
         for i in 0..20 {
@@ -137,6 +139,6 @@ mod tests {
             assert_eq!(got, values(&b, &q), "{q:?}");
         }
         let bx = Aabb::new(Vec3::splat(-3e38), Vec3::splat(3e38));
-        assert_eq!(g.aabb_hits(&bx).unwrap().len(), b.len());
+        assert_eq!(g.query(bx).unwrap().len(), b.len());
     }
 }

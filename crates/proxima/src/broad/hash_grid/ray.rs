@@ -15,10 +15,10 @@
 
 use super::keys::{KeyBox, LIMIT};
 use super::HashGrid;
-use crate::arena::Handle;
 use crate::broad::cell_list::CellEntry;
 use crate::broad::RayHit;
 use crate::geom::{overlap, Ray, Sphere};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 /// Relative padding of the ray's coordinates (rounding of `o + d t`).
@@ -39,18 +39,6 @@ enum Step<'a> {
 #[inline]
 fn meet(a0: i32, a1: i32, b0: i32, b1: i32) -> bool {
     a0.max(b0) <= a1.min(b1)
-}
-
-/// Keeps the smaller of `best` and `(t, h)`.
-#[inline]
-fn offer(best: &mut Option<RayHit>, t: f32, h: Handle) {
-    let better = match best {
-        None => true,
-        Some(b) => (t, h) < (b.t, b.handle),
-    };
-    if better {
-        *best = Some(RayHit { handle: h, t });
-    }
 }
 
 impl<T> HashGrid<T> {
@@ -319,17 +307,17 @@ impl<T> HashGrid<T> {
 
     /// The first hit (smallest `t`, ties by handle): the oversized objects first,
     /// then the walk, stopping once a hit precedes the strip just finished.
-    pub(super) fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
+    pub(super) fn ray_first_cells(&self, ray: &Ray) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
         for &slot in &self.oversized {
             if let Some(t) = overlap::ray_sphere(ray, &self.spheres[slot as usize]) {
-                offer(&mut best, t, self.handles[slot as usize]);
+                RayHit::offer(&mut best, t, self.handles[slot as usize]);
             }
         }
         let _ = self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
                 if let Some(t) = overlap::ray_sphere(ray, &self.spheres[e.slot as usize]) {
-                    offer(&mut best, t, self.handles[e.slot as usize]);
+                    RayHit::offer(&mut best, t, self.handles[e.slot as usize]);
                 }
                 ControlFlow::Continue(())
             }
@@ -347,12 +335,13 @@ impl<T> HashGrid<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::HashGridConfig;
     use crate::broad::{BruteForce, HashGrid, SpatialIndex};
     use crate::geom::{Ray, Segment, Sphere};
     use glam::{vec3, Vec3};
 
     fn sample() -> (HashGrid<u32>, BruteForce<u32>) {
-        let mut g = HashGrid::with_cell_size(3.0).unwrap();
+        let mut g = HashGrid::with_config(HashGridConfig { cell_size: 3.0 }).unwrap();
         let mut b = BruteForce::new();
         let mut k = 0u32;
         let mut add = |s: Sphere| {

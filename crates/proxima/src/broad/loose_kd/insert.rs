@@ -5,8 +5,9 @@
 use super::node::{all_space, Node, NIL};
 use super::store::room_for;
 use super::{Loc, LooseKdTree};
-use crate::arena::{Handle, Pool};
+use crate::arena::Pool;
 use crate::geom::Sphere;
+use crate::Handle;
 
 /// Compaction starts once the dead positions exceed this many plus half the
 /// live objects, or the nodes out of order this many plus an eighth of all

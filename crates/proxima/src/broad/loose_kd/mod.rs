@@ -27,34 +27,98 @@ mod tests;
 pub use stats::{KdStats, Placement};
 pub use visit::KdNodeView;
 
-use crate::arena::{Arena, Handle, Pool};
-use crate::broad::{RayHit, Selection, SpatialIndex};
+use crate::arena::{Arena, Pool};
+
+use crate::broad::walk::{walk_methods, Walk};
+use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
-use crate::{Error, Result};
+use crate::{Error, Handle, Result};
 use node::{Node, NIL};
 use std::ops::ControlFlow;
 use store::Store;
 
-/// A good density for scenes of many similar spheres moving a little per frame
-/// [sources: w1]: measured with the W1 frame (update all + all pairs). With the
-/// objects in one depth-first array (`store.rs`), 0.15 beat 0.2 at N = 100k
-/// (frame ~5–10% faster, 138 instead of 200 bytes per object, build twice as
-/// fast) and at 10k (~5–10%); 0.12 and 0.1 were 20–40% slower at 100k, 0.3 and
-/// 0.4 1.5–2× slower. The trade-off is scene-dependent: on W2 (flat world)
-/// 0.15 was also ~20% faster, but on W3 (tight clusters, ~7 pairs per object) its
-/// pair search was ~20–30% slower than with 0.2; pass a higher density for such
-/// scenes. Lower densities widen the border zones (more spheres stop
-/// high in the tree, more cross tests); higher ones deepen the tree (more nodes
-/// to walk and more moves that change node).
-pub const DEFAULT_DENSITY: f32 = 0.15;
-
 /// Largest accepted depth cap (it also sizes the fixed traversal stacks).
-pub const MAX_DEPTH_LIMIT: u8 = 64;
+pub(crate) const MAX_DEPTH_LIMIT: u8 = LooseKdConfig::MAX_DEPTH_LIMIT;
 
-/// Depth cap used by [`LooseKdTree::new`]: deep enough for worlds ~10⁶ times wider
-/// than the typical sphere, shallow enough that spheres of radius zero piled on one
-/// point stop after 40 levels instead of recursing until `f32` runs out of bits.
-pub const DEFAULT_MAX_DEPTH: u8 = 40;
+/// Everything a [`LooseKdTree`] is built from. [`LooseKdConfig::new`] takes the
+/// world box and `R_max` and sets the tuning to its defaults.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LooseKdConfig {
+    /// The box the tree subdivides (finite, not inverted). Objects outside it
+    /// are still stored exactly; see [`LooseKdTree`] for what they cost.
+    pub world: Aabb,
+    /// `R_max` (finite, `> 0`): spheres with at least this radius stay at the
+    /// root; the border zones are at most this wide.
+    pub r_max: f32,
+    /// The density `d` in `(0, 1]`: higher gives narrower border zones and a
+    /// deeper tree. Default [`LooseKdConfig::DEFAULT_DENSITY`].
+    pub density: f32,
+    /// The depth cap, `1..=`[`LooseKdConfig::MAX_DEPTH_LIMIT`] (the root is
+    /// depth 0). Default [`LooseKdConfig::DEFAULT_MAX_DEPTH`].
+    pub max_depth: u8,
+}
+
+impl LooseKdConfig {
+    /// A good density for scenes of many similar spheres moving a little per frame
+    /// [sources: w1]: measured with the W1 frame (update all + all pairs). With the
+    /// objects in one depth-first array (`store.rs`), 0.15 beat 0.2 at N = 100k
+    /// (frame ~5–10% faster, 138 instead of 200 bytes per object, build twice as
+    /// fast) and at 10k (~5–10%); 0.12 and 0.1 were 20–40% slower at 100k, 0.3 and
+    /// 0.4 1.5–2× slower. The trade-off is scene-dependent: on W2 (flat world)
+    /// 0.15 was also ~20% faster, but on W3 (tight clusters, ~7 pairs per object) its
+    /// pair search was ~20–30% slower than with 0.2; pass a higher density for such
+    /// scenes. Lower densities widen the border zones (more spheres stop
+    /// high in the tree, more cross tests); higher ones deepen the tree (more nodes
+    /// to walk and more moves that change node).
+    pub const DEFAULT_DENSITY: f32 = 0.15;
+
+    /// Largest accepted depth cap (it also sizes the fixed traversal stacks).
+    pub const MAX_DEPTH_LIMIT: u8 = 64;
+
+    /// Depth cap used by [`LooseKdConfig::new`]: deep enough for worlds ~10⁶ times wider
+    /// than the typical sphere, shallow enough that spheres of radius zero piled on one
+    /// point stop after 40 levels instead of recursing until `f32` runs out of bits.
+    pub const DEFAULT_MAX_DEPTH: u8 = 40;
+
+    /// The default tuning over `world` for spheres up to radius `r_max`.
+    pub fn new(world: Aabb, r_max: f32) -> Self {
+        LooseKdConfig {
+            world,
+            r_max,
+            density: Self::DEFAULT_DENSITY,
+            max_depth: Self::DEFAULT_MAX_DEPTH,
+        }
+    }
+
+    /// The default tuning over the hint's world box and `r_max`.
+    pub fn for_scene(hint: &SceneHint) -> Self {
+        Self::new(hint.world, hint.r_max)
+    }
+
+    /// Checks the ranges documented on the fields ([`Error::InvalidParameter`];
+    /// the world box gives its own error).
+    pub fn validate(&self) -> Result<()> {
+        self.world.validate()?;
+        let (r_max, density, max_depth) = (self.r_max, self.density, self.max_depth);
+        if !r_max.is_finite() || r_max <= 0.0 {
+            return Err(Error::InvalidParameter(format!(
+                "r_max must be finite and > 0, got {r_max}"
+            )));
+        }
+        if !(density > 0.0 && density <= 1.0) {
+            return Err(Error::InvalidParameter(format!(
+                "density must be in (0, 1], got {density}"
+            )));
+        }
+        if max_depth == 0 || max_depth > Self::MAX_DEPTH_LIMIT {
+            return Err(Error::InvalidParameter(format!(
+                "max_depth must be in 1..={}, got {max_depth}",
+                Self::MAX_DEPTH_LIMIT
+            )));
+        }
+        Ok(())
+    }
+}
 
 /// Where a stored object is: its node and its position in the node's range of
 /// the object array. The handle arena holds only this; the object itself is in
@@ -108,7 +172,7 @@ struct Loc {
 /// the order the pair search and the queries read them in. Insert and a move that leaves the node's
 /// cell are O(depth); a move inside the cell is O(1); removal is O(1) (swap with the
 /// node's last object) plus freeing emptied ancestors. Depth is
-/// capped ([`DEFAULT_MAX_DEPTH`], or [`LooseKdTree::with_max_depth`]): at the cap a
+/// capped ([`LooseKdConfig::max_depth`]): at the cap a
 /// node takes every sphere routed to it, so zero-radius spheres on one point end up
 /// in one node rather than recursing forever (queries then scan that node).
 ///
@@ -145,36 +209,25 @@ pub struct LooseKdTree<T> {
 }
 
 impl<T> LooseKdTree<T> {
-    /// An empty tree over `world` for spheres up to radius `r_max`, with density
-    /// `density` in `(0, 1]` (higher: narrower border zones, deeper tree) and the
-    /// default depth cap. Errors on a non-finite or inverted world box, a
-    /// non-positive or non-finite `r_max`, or a density outside `(0, 1]`.
+    /// An empty tree over `world` for spheres up to radius `r_max`, with the
+    /// default tuning ([`LooseKdConfig::new`]). Errors on a non-finite or
+    /// inverted world box or a non-positive or non-finite `r_max`.
     ///
     /// Objects outside `world` or larger than `r_max` are still accepted and
     /// answered exactly; see the type's docs for what they cost.
-    pub fn new(world: Aabb, r_max: f32, density: f32) -> Result<Self> {
-        Self::with_max_depth(world, r_max, density, DEFAULT_MAX_DEPTH)
+    pub fn new(world: Aabb, r_max: f32) -> Result<Self> {
+        Self::with_config(LooseKdConfig::new(world, r_max))
     }
 
-    /// As [`LooseKdTree::new`] with an explicit depth cap `1..=`[`MAX_DEPTH_LIMIT`]
-    /// (the root is depth 0).
-    pub fn with_max_depth(world: Aabb, r_max: f32, density: f32, max_depth: u8) -> Result<Self> {
-        world.validate()?;
-        if !r_max.is_finite() || r_max <= 0.0 {
-            return Err(Error::InvalidParameter(format!(
-                "r_max must be finite and > 0, got {r_max}"
-            )));
-        }
-        if !(density > 0.0 && density <= 1.0) {
-            return Err(Error::InvalidParameter(format!(
-                "density must be in (0, 1], got {density}"
-            )));
-        }
-        if max_depth == 0 || max_depth > MAX_DEPTH_LIMIT {
-            return Err(Error::InvalidParameter(format!(
-                "max_depth must be in 1..={MAX_DEPTH_LIMIT}, got {max_depth}"
-            )));
-        }
+    /// An empty tree as `config` says. Errors as [`LooseKdConfig::validate`].
+    pub fn with_config(config: LooseKdConfig) -> Result<Self> {
+        config.validate()?;
+        let LooseKdConfig {
+            world,
+            r_max,
+            density,
+            max_depth,
+        } = config;
         let mut t = LooseKdTree {
             items: Arena::new(),
             nodes: Pool::default(),
@@ -258,6 +311,8 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     }
 
     /// `Move` [sources: kd-move]; see the type's docs for when the object changes node.
+    /// Inline: a frame's update loop then holds the common in-node move.
+    #[inline]
     fn update(&mut self, handle: Handle, sphere: Sphere) -> Result<()> {
         sphere.validate()?;
         let loc = *self.items.get(handle)?;
@@ -294,7 +349,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.eps = node::slack(&self.span);
     }
 
-    fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
+    fn for_each(&self, f: &mut dyn FnMut(Handle, &Sphere, &T)) {
         for (_, loc) in self.items.iter() {
             let p = (self.nodes[loc.node].start + loc.pos) as usize;
             let (h, v) = self.store.at(p);
@@ -302,29 +357,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         }
     }
 
-    fn visit<Q: Selection + ?Sized>(
-        &self,
-        query: &Q,
-        f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
-    ) -> ControlFlow<()> {
-        self.visit_impl(query, f)
-    }
-
-    /// Node-vs-node walk over the nodes' contiguous objects (see `pairs.rs`). Its
-    /// buffers (20 bytes per carried object) are kept in the tree and reused, so
-    /// repeated calls do not allocate once they have grown.
-    fn for_each_pair(
-        &self,
-        f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
-    ) -> ControlFlow<()> {
-        self.pairs_impl(f)
-    }
-
-    /// Front-to-back: nearer child first, subtrees whose region the ray enters
-    /// after the best hit so far are skipped.
-    fn ray_first_unchecked(&self, ray: &Ray) -> Option<RayHit> {
-        self.ray_first_impl(ray)
-    }
+    walk_methods!(T);
 
     fn validate(&self) -> Result<()> {
         self.validate_impl()
@@ -338,5 +371,35 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
             + self.nodes.heap_bytes()
             + self.store.heap_bytes()
             + self.scratch.heap_bytes()
+    }
+
+    fn kind(&self) -> IndexKind {
+        IndexKind::LooseKd
+    }
+}
+
+impl<T> Walk<T> for LooseKdTree<T> {
+    fn walk<Q: Selection + ?Sized>(
+        &self,
+        query: &Q,
+        f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        self.visit_impl(query, f)
+    }
+
+    /// Node-vs-node walk over the nodes' contiguous objects (see `pairs.rs`). Its
+    /// buffers (20 bytes per carried object) are kept in the tree and reused, so
+    /// repeated calls do not allocate once they have grown.
+    fn walk_pairs(
+        &self,
+        f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        self.pairs_impl(f)
+    }
+
+    /// Front-to-back: nearer child first, subtrees whose region the ray enters
+    /// after the best hit so far are skipped.
+    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
+        self.ray_first_impl(ray)
     }
 }

@@ -33,8 +33,8 @@
 
 use super::node::{FixedStack, NIL};
 use super::LooseKdTree;
-use crate::arena::Handle;
 use crate::geom::{overlap, Sphere};
+use crate::Handle;
 use glam::{Vec3, Vec4};
 use std::ops::ControlFlow;
 use std::sync::{Mutex, TryLockError};

@@ -14,8 +14,8 @@
 use super::node::NIL;
 use super::pairs::Buffers;
 use super::LooseKdTree;
-use crate::arena::Handle;
 use crate::broad::ParallelPairs;
+use crate::Handle;
 use std::ops::ControlFlow;
 
 /// Nodes at this depth or deeper (root = 0) run their whole subtree as one task:

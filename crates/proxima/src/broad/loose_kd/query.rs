@@ -4,9 +4,9 @@
 use super::node::{FixedStack, NIL};
 use super::store::CHUNK;
 use super::LooseKdTree;
-use crate::arena::Handle;
 use crate::broad::{RayHit, Selection};
 use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
+use crate::Handle;
 use glam::Vec3;
 use std::ops::{ControlFlow, Range};
 
@@ -243,12 +243,7 @@ impl<T> LooseKdTree<T> {
                 // clamps into `[.., max_t]`); the shortened `r` only prunes boxes.
                 if let Some(t) = overlap::ray_sphere(ray, s).filter(|&t| t <= r.max_t) {
                     let h = self.store.at(q).0;
-                    let better = match best {
-                        None => true,
-                        Some(b) => (t, h) < (b.t, b.handle),
-                    };
-                    if better {
-                        best = Some(RayHit { handle: h, t });
+                    if RayHit::offer(&mut best, t, h) {
                         r.max_t = t;
                     }
                 }

@@ -2,8 +2,8 @@
 
 use super::node::NIL;
 use super::LooseKdTree;
-use crate::arena::Handle;
 use crate::geom::Aabb;
+use crate::Handle;
 use crate::Result;
 
 /// Shape of a [`LooseKdTree`] (see [`LooseKdTree::stats`]).

@@ -27,8 +27,8 @@
 //! are far from a small query. A box may cover objects of two neighbouring
 //! ranges (ranges are not aligned to chunks): it is looser, never wrong.
 
-use crate::arena::Handle;
 use crate::geom::{Aabb, Sphere};
+use crate::Handle;
 use glam::Vec3;
 
 /// Positions per chunk bound: 8 spheres are two cache lines, so a pruned chunk

@@ -2,7 +2,13 @@
 //! `tests/oracle` and `tests/loose_kd.rs`).
 
 use super::*;
+
+use crate::broad::walk::Walk;
+
+use crate::broad::LooseKdConfig;
+
 use crate::broad::BruteForce;
+use crate::broad::SpatialIndexExt;
 use glam::{vec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -42,28 +48,91 @@ fn seed_placement(world: Aabb, r_max: f32, d: f32, cap: usize, s: &Sphere) -> (u
 #[test]
 fn bad_parameters_are_rejected() {
     let w = cube(10.0);
-    assert!(LooseKdTree::<()>::new(w, 1.0, 0.5).is_ok());
-    assert!(LooseKdTree::<()>::new(w, 0.0, 0.5).is_err());
-    assert!(LooseKdTree::<()>::new(w, -1.0, 0.5).is_err());
-    assert!(LooseKdTree::<()>::new(w, f32::NAN, 0.5).is_err());
-    assert!(LooseKdTree::<()>::new(w, f32::INFINITY, 0.5).is_err());
-    assert!(LooseKdTree::<()>::new(w, 1.0, 0.0).is_err());
-    assert!(LooseKdTree::<()>::new(w, 1.0, 1.0001).is_err());
-    assert!(LooseKdTree::<()>::new(w, 1.0, f32::NAN).is_err());
-    assert!(LooseKdTree::<()>::new(w, 1.0, 1.0).is_ok());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(w, 1.0)
+    })
+    .is_ok());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(w, 0.0)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(w, -1.0)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(w, f32::NAN)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(w, f32::INFINITY)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.0,
+        ..LooseKdConfig::new(w, 1.0)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 1.0001,
+        ..LooseKdConfig::new(w, 1.0)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: f32::NAN,
+        ..LooseKdConfig::new(w, 1.0)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 1.0,
+        ..LooseKdConfig::new(w, 1.0)
+    })
+    .is_ok());
     let inverted = Aabb::new(Vec3::ONE, Vec3::ZERO);
-    assert!(LooseKdTree::<()>::new(inverted, 1.0, 0.5).is_err());
-    assert!(LooseKdTree::<()>::new(Aabb::new(Vec3::ZERO, Vec3::INFINITY), 1.0, 0.5).is_err());
-    assert!(LooseKdTree::<()>::with_max_depth(w, 1.0, 0.5, 0).is_err());
-    assert!(LooseKdTree::<()>::with_max_depth(w, 1.0, 0.5, MAX_DEPTH_LIMIT + 1).is_err());
-    assert!(LooseKdTree::<()>::with_max_depth(w, 1.0, 0.5, MAX_DEPTH_LIMIT).is_ok());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(inverted, 1.0)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(Aabb::new(Vec3::ZERO, Vec3::INFINITY), 1.0)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        max_depth: 0,
+        ..LooseKdConfig::new(w, 1.0)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        max_depth: MAX_DEPTH_LIMIT + 1,
+        ..LooseKdConfig::new(w, 1.0)
+    })
+    .is_err());
+    assert!(LooseKdTree::<()>::with_config(LooseKdConfig {
+        density: 0.5,
+        max_depth: MAX_DEPTH_LIMIT,
+        ..LooseKdConfig::new(w, 1.0)
+    })
+    .is_ok());
 }
 
 #[test]
 fn crafted_spheres_land_where_the_seed_puts_them() {
     // World 16 x 8 x 8, d = 1, R_max large: root splits x at m = 8 with h = 4.
     let world = Aabb::new(Vec3::ZERO, vec3(16.0, 8.0, 8.0));
-    let mut t = LooseKdTree::new(world, 100.0, 1.0).unwrap();
+    let mut t = LooseKdTree::with_config(LooseKdConfig {
+        density: 1.0,
+        ..LooseKdConfig::new(world, 100.0)
+    })
+    .unwrap();
     let at = |t: &LooseKdTree<u32>, h| {
         let p = t.placement(h).unwrap();
         (p.depth, p.node_box)
@@ -111,7 +180,12 @@ fn crafted_spheres_land_where_the_seed_puts_them() {
 fn placement_invariant_over_random_history() {
     for (d, cap) in [(0.5, 40u8), (0.1, 40), (1.0, 6)] {
         let world = Aabb::new(vec3(-50.0, 0.0, 0.0), vec3(50.0, 60.0, 20.0));
-        let mut t = LooseKdTree::with_max_depth(world, 2.0, d, cap).unwrap();
+        let mut t = LooseKdTree::with_config(LooseKdConfig {
+            density: d,
+            max_depth: cap,
+            ..LooseKdConfig::new(world, 2.0)
+        })
+        .unwrap();
         let mut rng = Pcg64::seed_from_u64(7);
         let mut live = Vec::new();
         let sphere = |rng: &mut Pcg64| {
@@ -168,7 +242,11 @@ fn placement_invariant_over_random_history() {
 fn shape_is_independent_of_history() {
     let world = cube(100.0);
     let mut rng = Pcg64::seed_from_u64(3);
-    let mut moved = LooseKdTree::new(world, 2.0, 0.5).unwrap();
+    let mut moved = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(world, 2.0)
+    })
+    .unwrap();
     let mut hs = Vec::new();
     for i in 0..2000 {
         let c = vec3(
@@ -195,8 +273,12 @@ fn shape_is_independent_of_history() {
                 .unwrap();
         }
     }
-    let mut fresh = LooseKdTree::new(world, 2.0, 0.5).unwrap();
-    moved.for_each(|_, s, v| {
+    let mut fresh = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(world, 2.0)
+    })
+    .unwrap();
+    moved.for_each(&mut |_, s, v| {
         fresh.insert(*s, *v).unwrap();
     });
     moved.validate().unwrap();
@@ -206,15 +288,23 @@ fn shape_is_independent_of_history() {
 
 #[test]
 fn depth_cap_holds_100k_points_on_one_point() {
-    let mut t = LooseKdTree::new(cube(100.0), 2.0, 0.5).unwrap();
+    let mut t = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(cube(100.0), 2.0)
+    })
+    .unwrap();
     let p = vec3(37.5, 12.25, 80.0);
     let hs: Vec<_> = (0..100_000)
         .map(|i| t.insert(Sphere::new(p, 0.0), i).unwrap())
         .collect();
     t.validate().unwrap();
     let st = t.stats();
-    assert_eq!(st.max_depth, DEFAULT_MAX_DEPTH as usize);
-    assert_eq!(st.nodes, DEFAULT_MAX_DEPTH as usize + 1, "one path");
+    assert_eq!(st.max_depth, LooseKdConfig::DEFAULT_MAX_DEPTH as usize);
+    assert_eq!(
+        st.nodes,
+        LooseKdConfig::DEFAULT_MAX_DEPTH as usize + 1,
+        "one path"
+    );
     assert_eq!(st.max_items_per_node, 100_000);
     assert_eq!(t.within(p, 0.0).unwrap().len(), 100_000);
     assert!(t.within(p + Vec3::X, 0.5).unwrap().is_empty());
@@ -230,7 +320,11 @@ fn depth_cap_holds_100k_points_on_one_point() {
 
 #[test]
 fn ray_first_ties_go_to_the_smallest_handle() {
-    let mut t = LooseKdTree::new(cube(100.0), 2.0, 0.5).unwrap();
+    let mut t = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(cube(100.0), 2.0)
+    })
+    .unwrap();
     let mut b = BruteForce::new();
     let s = Sphere::new(vec3(50.0, 50.0, 50.0), 1.0);
     let mut hs = Vec::new();
@@ -250,7 +344,11 @@ fn ray_first_ties_go_to_the_smallest_handle() {
 
 #[test]
 fn memory_is_pooled_and_released_by_clear() {
-    let mut t = LooseKdTree::new(cube(100.0), 2.0, 0.5).unwrap();
+    let mut t = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(cube(100.0), 2.0)
+    })
+    .unwrap();
     let empty = t.memory_bytes();
     let mut rng = Pcg64::seed_from_u64(9);
     let hs: Vec<_> = (0..1000)
@@ -275,7 +373,11 @@ fn memory_is_pooled_and_released_by_clear() {
 
 #[test]
 fn stale_handles_and_bad_spheres_change_nothing() {
-    let mut t = LooseKdTree::new(cube(10.0), 1.0, 0.5).unwrap();
+    let mut t = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.5,
+        ..LooseKdConfig::new(cube(10.0), 1.0)
+    })
+    .unwrap();
     let h = t.insert(Sphere::new(Vec3::ONE, 0.5), 1).unwrap();
     let before = t.stats();
     assert!(t.update(h, Sphere::new(Vec3::NAN, 0.5)).is_err());
@@ -310,7 +412,11 @@ fn crowded_nodes_sweep_finds_exactly_touching_pairs() {
     // neighbour touches exactly) all stop at the root, so the root's own test and
     // the carried sets of the nodes below are far above the sweep threshold.
     let world = cube(20.0);
-    let mut t = LooseKdTree::new(world, 2.0, 0.2).unwrap();
+    let mut t = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.2,
+        ..LooseKdConfig::new(world, 2.0)
+    })
+    .unwrap();
     let mut b = BruteForce::new();
     let mut rng = Pcg64::seed_from_u64(17);
     let mut hs = Vec::new();
@@ -358,7 +464,11 @@ fn crowded_nodes_sweep_finds_exactly_touching_pairs() {
 
 #[test]
 fn nested_pair_searches_use_their_own_buffers() {
-    let mut t = LooseKdTree::new(cube(20.0), 2.0, 0.2).unwrap();
+    let mut t = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.2,
+        ..LooseKdConfig::new(cube(20.0), 2.0)
+    })
+    .unwrap();
     let mut rng = Pcg64::seed_from_u64(5);
     for i in 0..500u32 {
         let c = vec3(
@@ -388,7 +498,11 @@ fn object_array_compacts_and_stays_exact_under_moves() {
     // Many small moves across cell borders relocate ranges and free nodes; the
     // array must get compacted (bounded dead and out-of-order counts), stay valid,
     // and keep giving the brute-force pairs and payloads.
-    let mut t = LooseKdTree::new(cube(60.0), 2.0, 0.25).unwrap();
+    let mut t = LooseKdTree::with_config(LooseKdConfig {
+        density: 0.25,
+        ..LooseKdConfig::new(cube(60.0), 2.0)
+    })
+    .unwrap();
     let mut b = BruteForce::new();
     let mut rng = Pcg64::seed_from_u64(21);
     let mut objs: Vec<(Handle, Handle, Sphere)> = Vec::new();
@@ -434,9 +548,9 @@ fn object_array_compacts_and_stays_exact_under_moves() {
 const COMPACT_BOUND: usize = 64 + 64;
 
 /// Handles `index` selects for `q`, sorted.
-fn selected<I: SpatialIndex<u32>, Q: Selection>(index: &I, q: &Q) -> Vec<u32> {
+fn selected<I: Walk<u32>, Q: Selection>(index: &I, q: &Q) -> Vec<u32> {
     let mut v = Vec::new();
-    let _ = index.visit(q, |_, _, &x| {
+    let _ = index.walk(q, |_, _, &x| {
         v.push(x);
         ControlFlow::Continue(())
     });
@@ -453,7 +567,7 @@ fn chunk_bounds_prune_exactly_under_moves_removals_and_odd_queries() {
     use crate::geom::Frustum;
     use glam::Mat4;
     let side = 80.0;
-    let mut t = LooseKdTree::new(cube(side), 2.0, DEFAULT_DENSITY).unwrap();
+    let mut t = LooseKdTree::new(cube(side), 2.0).unwrap();
     let mut b = BruteForce::new();
     let mut rng = Pcg64::seed_from_u64(77);
     let mut objs: Vec<(Handle, Handle, Sphere, u32)> = Vec::new();

@@ -65,6 +65,7 @@ impl<T> LooseKdTree<T> {
 
 #[cfg(test)]
 mod tests {
+    use crate::broad::LooseKdConfig;
     use crate::broad::{LooseKdTree, SpatialIndex};
     use crate::geom::{Aabb, Sphere};
     use glam::Vec3;
@@ -72,7 +73,11 @@ mod tests {
     #[test]
     fn visitor_sees_every_node_and_item_once_with_tiling_cells() {
         let world = Aabb::new(Vec3::ZERO, Vec3::splat(64.0));
-        let mut t = LooseKdTree::new(world, 2.0, 0.25).unwrap();
+        let mut t = LooseKdTree::with_config(LooseKdConfig {
+            density: 0.25,
+            ..LooseKdConfig::new(world, 2.0)
+        })
+        .unwrap();
         let mut seed = 7u32;
         let mut next = || {
             seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);

@@ -111,6 +111,10 @@ impl LocationCode {
     /// The root cell (the whole world box): the bare sentinel.
     pub const ROOT: LocationCode = LocationCode(1);
 
+    /// Deepest level a code can name: 21 (three bits per level and the
+    /// sentinel bit fill a `u64`).
+    pub const MAX_DEPTH: u32 = MAX_DEPTH;
+
     /// The root cell.
     #[inline]
     pub fn root() -> LocationCode {
@@ -151,7 +155,7 @@ impl LocationCode {
     }
 
     /// The depth-`depth` cell containing point `p`, cells dividing `world` (the
-    /// point is clamped into `world` first; `depth` is capped at [`MAX_DEPTH`]).
+    /// point is clamped into `world` first; `depth` is capped at [`LocationCode::MAX_DEPTH`]).
     /// Cells are half-open except on the world's upper faces.
     pub fn of_point(world: &Aabb, p: Vec3, depth: u32) -> LocationCode {
         let depth = depth.min(MAX_DEPTH);
@@ -188,7 +192,7 @@ impl LocationCode {
     }
 
     /// Child `k` (bit 0 = high x half, bit 1 = high y, bit 2 = high z), or `None`
-    /// at [`MAX_DEPTH`] or for `k > 7`.
+    /// at [`LocationCode::MAX_DEPTH`] or for `k > 7`.
     #[inline]
     pub fn child(self, k: u8) -> Option<LocationCode> {
         (k < 8 && self.depth() < MAX_DEPTH).then_some(LocationCode((self.0 << 3) | k as u64))

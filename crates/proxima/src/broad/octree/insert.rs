@@ -4,8 +4,8 @@
 use super::code::MAX_DEPTH;
 use super::node::{Item, Obj, NONE};
 use super::LinearOctree;
-use crate::arena::Handle;
 use crate::geom::Sphere;
+use crate::Handle;
 use crate::Result;
 
 impl<T> LinearOctree<T> {

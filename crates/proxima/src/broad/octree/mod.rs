@@ -18,24 +18,30 @@ mod validate;
 #[cfg(test)]
 mod tests;
 
-pub use code::{Face, LocationCode, MAX_DEPTH};
+pub(crate) use code::MAX_DEPTH;
+pub use code::{Face, LocationCode};
 pub use stats::OctreeStats;
 
-use crate::arena::{Arena, Handle, Pool};
-use crate::broad::{RayHit, Selection, SpatialIndex};
+use crate::arena::{Arena, Pool};
+
+use crate::broad::walk::{walk_methods, Walk};
+use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
-use crate::{Error, Result};
+use crate::{Error, Handle, Result};
 use glam::Vec3;
 use node::{Node, Obj};
 use rustc_hash::FxHashMap;
 use std::ops::ControlFlow;
 
-/// Tuning of a [`LinearOctree`]. `Default` gives 32 objects per leaf, merge below
-/// 16, depth up to 16: on W1 at N = 100k, leaves of up to 32 made a frame (update
-/// all + all pairs) about twice as fast as leaves of up to 8 (fewer nodes to
-/// visit; see `examples/octree_w1.rs`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Everything a [`LinearOctree`] is built from. [`OctreeConfig::new`] gives 32
+/// objects per leaf, merge below 16, depth up to 16: on W1 at N = 100k, leaves
+/// of up to 32 made a frame (update all + all pairs) about twice as fast as
+/// leaves of up to 8 (fewer nodes to visit; see `examples/octree_w1.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OctreeConfig {
+    /// The box the root cell covers (any finite box; a degenerate one is
+    /// widened to a unit cube). Objects outside it are still stored exactly.
+    pub world: Aabb,
     /// A leaf splits into octants when it holds more than this many objects (and is
     /// shallower than `max_depth`). At least 1.
     pub max_per_leaf: u32,
@@ -46,25 +52,33 @@ pub struct OctreeConfig {
     /// oscillating across a border from splitting and merging every frame. `0`
     /// disables merging (emptied leaves are still deleted).
     pub merge_below: u32,
-    /// Deepest level a leaf may have, at most [`MAX_DEPTH`] (21). Leaves at this
-    /// depth hold any number of objects (coincident centres cannot be separated).
+    /// Deepest level a leaf may have, at most [`LocationCode::MAX_DEPTH`] (21).
+    /// Leaves at this depth hold any number of objects (coincident centres cannot
+    /// be separated).
     pub max_depth: u32,
 }
 
-impl Default for OctreeConfig {
-    fn default() -> Self {
+impl OctreeConfig {
+    /// The default tuning over `world`.
+    pub fn new(world: Aabb) -> Self {
         OctreeConfig {
+            world,
             max_per_leaf: 32,
             merge_below: 16,
             max_depth: 16,
         }
     }
-}
 
-impl OctreeConfig {
-    /// Checks the ranges documented on the fields.
+    /// The default tuning over the hint's world box.
+    pub fn for_scene(hint: &SceneHint) -> Self {
+        Self::new(hint.world)
+    }
+
+    /// Checks the ranges documented on the fields ([`Error::InvalidParameter`];
+    /// the world box gives its own error).
     pub fn validate(&self) -> Result<()> {
-        let bad = |m: &str| Err(Error::Invalid(format!("octree config: {m}")));
+        self.world.validate()?;
+        let bad = |m: &str| Err(Error::InvalidParameter(format!("octree config: {m}")));
         if self.max_per_leaf == 0 {
             return bad("max_per_leaf must be at least 1");
         }
@@ -84,7 +98,7 @@ impl OctreeConfig {
 /// the box's longest extent (the source's cells are cubes; a flat world thus gets
 /// cubic cells, not slabs). Every node is named by its [`LocationCode`]; a
 /// [`FxHashMap`] from code to node index replaces pointers for random access (the
-/// source's MAP), and nodes live in a [`Pool`] with a free list. Inner nodes also keep
+/// source's MAP), and nodes live in a pool with a free list. Inner nodes also keep
 /// the indices of their children for top-down traversals. The tree is sparse: a
 /// split creates only the octants that receive objects, and an object moving into
 /// empty space creates the one leaf it needs. Emptied leaves are deleted.
@@ -111,10 +125,10 @@ impl OctreeConfig {
 /// of the new centre by a binary search over depths (≈ log2(depth) map lookups).
 /// The three paths are counted in [`LinearOctree::stats`].
 ///
-/// **Queries** traverse nodes with loose boxes through [`Selection::classify_box`];
+/// **Queries** traverse nodes with loose boxes (each query shape classifies a box);
 /// a subtree classified `Inside` (frustum, box) is reported without further tests,
 /// and frustum plane masks skip planes that already contain a parent.
-/// [`SpatialIndex::for_each_pair`] is a simultaneous traversal of the tree with
+/// [`SpatialIndex::visit_pairs`] is a simultaneous traversal of the tree with
 /// itself, pruned by loose boxes (on W1 at N = 100k about 4–5× faster than one
 /// sphere query per object, measured with `examples/octree_w1.rs`). The first ray
 /// hit is a front-to-back search. No query allocates.
@@ -149,10 +163,16 @@ pub struct LinearOctree<T> {
 
 impl<T> LinearOctree<T> {
     /// An empty octree over `world` (any finite box; a degenerate one is widened to
-    /// a unit cube). Errors on a non-finite or inverted box or a bad `config`.
-    pub fn new(world: Aabb, config: OctreeConfig) -> Result<Self> {
-        world.validate()?;
+    /// a unit cube) with the default tuning ([`OctreeConfig::new`]). Errors on a
+    /// non-finite or inverted box.
+    pub fn new(world: Aabb) -> Result<Self> {
+        Self::with_config(OctreeConfig::new(world))
+    }
+
+    /// An empty octree as `config` says. Errors as [`OctreeConfig::validate`].
+    pub fn with_config(config: OctreeConfig) -> Result<Self> {
         config.validate()?;
+        let world = config.world;
         let mut side = world.extent().max_element();
         if side <= 0.0 {
             side = 1.0;
@@ -194,7 +214,7 @@ impl<T> LinearOctree<T> {
         &self.config
     }
 
-    /// The world box given to [`LinearOctree::new`].
+    /// The world box of the config.
     pub fn world(&self) -> &Aabb {
         &self.world
     }
@@ -265,13 +285,29 @@ impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
         self.clear_all();
     }
 
-    fn for_each(&self, mut f: impl FnMut(Handle, &Sphere, &T)) {
+    fn for_each(&self, f: &mut dyn FnMut(Handle, &Sphere, &T)) {
         for (h, o) in self.objects.iter() {
             f(h, &o.sphere, &o.value);
         }
     }
 
-    fn visit<Q: Selection + ?Sized>(
+    walk_methods!(T);
+
+    fn validate(&self) -> Result<()> {
+        self.validate_tree()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.memory()
+    }
+
+    fn kind(&self) -> IndexKind {
+        IndexKind::Octree
+    }
+}
+
+impl<T> Walk<T> for LinearOctree<T> {
+    fn walk<Q: Selection + ?Sized>(
         &self,
         query: &Q,
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
@@ -279,7 +315,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
         self.visit_tree(query, &mut f)
     }
 
-    fn for_each_pair(
+    fn walk_pairs(
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
@@ -288,15 +324,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
 
     /// Front-to-back: children in order of entry along the ray, subtrees entered
     /// after the best hit so far skipped.
-    fn ray_first_unchecked(&self, ray: &Ray) -> Option<RayHit> {
+    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
         self.ray_first_tree(ray)
-    }
-
-    fn validate(&self) -> Result<()> {
-        self.validate_tree()
-    }
-
-    fn memory_bytes(&self) -> usize {
-        self.memory()
     }
 }

@@ -3,8 +3,9 @@
 
 use super::code::{cell_box_of, point_key, LocationCode, MAX_DEPTH};
 use super::LinearOctree;
-use crate::arena::{Arena, Handle, Pool};
+use crate::arena::{Arena, Pool};
 use crate::geom::{Aabb, Sphere};
+use crate::Handle;
 use glam::Vec3;
 
 /// "No node" in parent/child links.

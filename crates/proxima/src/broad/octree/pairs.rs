@@ -5,8 +5,8 @@
 use super::node::{Node, NONE};
 use super::query::child_coords;
 use super::LinearOctree;
-use crate::arena::Handle;
 use crate::geom::{overlap, Aabb};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 /// A node with its cell coordinates, depth and loose box, as the pair traversal

@@ -4,9 +4,9 @@
 
 use super::node::NONE;
 use super::LinearOctree;
-use crate::arena::Handle;
 use crate::broad::Selection;
 use crate::geom::{Frustum, Relation, Sphere};
+use crate::Handle;
 use std::ops::ControlFlow;
 
 /// Child `k`'s integer coordinates from its parent's.

@@ -37,16 +37,7 @@ impl<T> LinearOctree<T> {
         if n.leaf {
             for it in &n.items {
                 if let Some(t) = overlap::ray_sphere(ray, &it.sphere) {
-                    let better = match best {
-                        None => true,
-                        Some(b) => (t, it.handle) < (b.t, b.handle),
-                    };
-                    if better {
-                        *best = Some(RayHit {
-                            handle: it.handle,
-                            t,
-                        });
-                    }
+                    RayHit::offer(best, t, it.handle);
                 }
             }
             return;

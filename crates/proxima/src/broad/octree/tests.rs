@@ -2,7 +2,11 @@
 //! queries and pairs against brute force).
 
 use super::*;
+
+use crate::broad::OctreeConfig;
+
 use crate::broad::SpatialIndex;
+use crate::broad::SpatialIndexExt;
 use crate::geom::{Frustum, Relation, Sphere};
 use glam::{vec3, Mat4};
 use rand::{Rng, SeedableRng};
@@ -19,6 +23,7 @@ fn cfg(max_per_leaf: u32, merge_below: u32, max_depth: u32) -> OctreeConfig {
         max_per_leaf,
         merge_below,
         max_depth,
+        ..OctreeConfig::new(world())
     }
 }
 
@@ -90,7 +95,11 @@ fn brute_face_patch(leaves: &[LocationCode], code: LocationCode, f: Face) -> Vec
 
 fn clustered_tree(seed: u64, n: usize) -> LinearOctree<usize> {
     let mut rng = Pcg64::seed_from_u64(seed);
-    let mut t = LinearOctree::new(world(), cfg(2, 1, 8)).unwrap();
+    let mut t = LinearOctree::with_config(OctreeConfig {
+        world: world(),
+        ..cfg(2, 1, 8)
+    })
+    .unwrap();
     let centres = [
         vec3(10.0, 10.0, 10.0),
         vec3(40.0, 20.0, 50.0),
@@ -176,7 +185,11 @@ fn face_neighbors_across_depths_match_brute_force() {
 fn twelve_moving_objects_use_the_neighbour_path() {
     let mut rng = Pcg64::seed_from_u64(4);
     let w = world();
-    let mut t: LinearOctree<usize> = LinearOctree::new(w, cfg(1, 1, 10)).unwrap();
+    let mut t: LinearOctree<usize> = LinearOctree::with_config(OctreeConfig {
+        world: w,
+        ..cfg(1, 1, 10)
+    })
+    .unwrap();
     let mut pos = Vec::new();
     let mut vel = Vec::new();
     let mut hs = Vec::new();
@@ -287,7 +300,11 @@ fn twelve_moving_objects_use_the_neighbour_path() {
 
 #[test]
 fn border_oscillation_does_not_split_and_merge_every_frame() {
-    let mut t: LinearOctree<u32> = LinearOctree::new(world(), cfg(4, 2, 10)).unwrap();
+    let mut t: LinearOctree<u32> = LinearOctree::with_config(OctreeConfig {
+        world: world(),
+        ..cfg(4, 2, 10)
+    })
+    .unwrap();
     // Four objects in the low-x half of the root, one oscillating across x = 32.
     for i in 0..4 {
         t.insert(Sphere::new(vec3(10.0 + i as f32, 10.0, 10.0), 0.5), i)
@@ -314,7 +331,11 @@ fn border_oscillation_does_not_split_and_merge_every_frame() {
     // The tightest allowed setting, merge_below = max_per_leaf, still has one
     // object of hysteresis: an object moving in and out of a full leaf's cell
     // splits it once (5 > 4) and never merges it back (4 is not below 4).
-    let mut t: LinearOctree<u32> = LinearOctree::new(world(), cfg(4, 4, 10)).unwrap();
+    let mut t: LinearOctree<u32> = LinearOctree::with_config(OctreeConfig {
+        world: world(),
+        ..cfg(4, 4, 10)
+    })
+    .unwrap();
     for i in 0..4 {
         t.insert(Sphere::new(vec3(10.0 + i as f32, 10.0, 10.0), 0.5), i)
             .unwrap();
@@ -345,18 +366,38 @@ fn border_oscillation_does_not_split_and_merge_every_frame() {
 #[test]
 fn config_and_world_are_validated() {
     let w = world();
-    assert!(LinearOctree::<()>::new(w, cfg(0, 0, 8)).is_err());
-    assert!(LinearOctree::<()>::new(w, cfg(4, 5, 8)).is_err());
-    assert!(LinearOctree::<()>::new(w, cfg(4, 2, 22)).is_err());
-    assert!(LinearOctree::<()>::new(Aabb::new(Vec3::ONE, Vec3::ZERO), cfg(4, 2, 8)).is_err());
-    assert!(
-        LinearOctree::<()>::new(Aabb::new(Vec3::ZERO, Vec3::splat(f32::NAN)), cfg(4, 2, 8))
-            .is_err()
-    );
-    assert!(LinearOctree::<()>::new(w, cfg(4, 0, 21)).is_ok());
+    assert!(LinearOctree::<()>::with_config(OctreeConfig {
+        world: w,
+        ..cfg(0, 0, 8)
+    })
+    .is_err());
+    assert!(LinearOctree::<()>::with_config(OctreeConfig {
+        world: w,
+        ..cfg(4, 5, 8)
+    })
+    .is_err());
+    assert!(LinearOctree::<()>::with_config(OctreeConfig {
+        world: w,
+        ..cfg(4, 2, 22)
+    })
+    .is_err());
+    assert!(LinearOctree::<()>::with_config(OctreeConfig {
+        world: Aabb::new(Vec3::ONE, Vec3::ZERO),
+        ..cfg(4, 2, 8)
+    })
+    .is_err());
+    assert!(LinearOctree::<()>::with_config(OctreeConfig {
+        world: Aabb::new(Vec3::ZERO, Vec3::splat(f32::NAN)),
+        ..cfg(4, 2, 8)
+    })
+    .is_err());
+    assert!(LinearOctree::<()>::with_config(OctreeConfig {
+        world: w,
+        ..cfg(4, 0, 21)
+    })
+    .is_ok());
     // A degenerate (point) world still works: everything is clamped onto it.
-    let mut t =
-        LinearOctree::new(Aabb::new(Vec3::ONE, Vec3::ONE), OctreeConfig::default()).unwrap();
+    let mut t = LinearOctree::new(Aabb::new(Vec3::ONE, Vec3::ONE)).unwrap();
     for i in 0..50 {
         t.insert(Sphere::new(vec3(i as f32, 0.0, -(i as f32)), 1.0), i)
             .unwrap();
@@ -367,7 +408,11 @@ fn config_and_world_are_validated() {
 
 #[test]
 fn merge_disabled_still_deletes_empty_leaves() {
-    let mut t: LinearOctree<usize> = LinearOctree::new(world(), cfg(1, 0, 8)).unwrap();
+    let mut t: LinearOctree<usize> = LinearOctree::with_config(OctreeConfig {
+        world: world(),
+        ..cfg(1, 0, 8)
+    })
+    .unwrap();
     let mut rng = Pcg64::seed_from_u64(9);
     let hs: Vec<_> = (0..200)
         .map(|i| {
@@ -393,6 +438,8 @@ struct Counting<'a> {
     inner: Frustum,
     tests: &'a Cell<usize>,
 }
+
+impl crate::broad::selection::sealed::Sealed for Counting<'_> {}
 
 impl Selection for Counting<'_> {
     fn validate(&self) -> crate::Result<()> {
@@ -422,7 +469,7 @@ fn frustum_reports_inside_subtrees_without_testing_spheres() {
         tests: &tests,
     };
     let mut n = 0;
-    let _ = t.visit(&q, |_, _, _| {
+    let _ = t.walk(&q, |_, _, _| {
         n += 1;
         std::ops::ControlFlow::Continue(())
     });
@@ -437,12 +484,12 @@ fn frustum_reports_inside_subtrees_without_testing_spheres() {
     };
     tests.set(0);
     let mut got = Vec::new();
-    let _ = t.visit(&q, |h, _, _| {
+    let _ = t.walk(&q, |h, _, _| {
         got.push(h);
         std::ops::ControlFlow::Continue(())
     });
     let mut want = Vec::new();
-    t.for_each(|h, s, _| {
+    t.for_each(&mut |h, s, _| {
         if fr.selects(s) {
             want.push(h)
         }

@@ -6,8 +6,8 @@
 use super::code::{Face, LocationCode, MAX_DEPTH};
 use super::node::Item;
 use super::LinearOctree;
-use crate::arena::Handle;
 use crate::geom::Sphere;
+use crate::Handle;
 
 impl<T> LinearOctree<T> {
     /// Moves/resizes live object `h` to the validated sphere `sphere`.

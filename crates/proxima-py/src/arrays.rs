@@ -133,17 +133,18 @@ pub fn rows(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<(Vec<f3
 /// [`rows`], refusing NaN and ±∞ (naming the row).
 pub fn finite_rows(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<(Vec<f32>, usize)> {
     let (v, n) = rows(obj, cols, what)?;
-    check_finite(&v, cols, what)?;
+    check_finite(&v, cols, what, "row")?;
     Ok((v, n))
 }
 
-/// Fails on the first non-finite value, naming its row.
-pub fn check_finite(v: &[f32], cols: usize, what: &str) -> PyResult<()> {
+/// Fails on the first non-finite value, naming its item (`unit` `i`: the
+/// `i`-th group of `size` values, a row, a matrix, a pose).
+pub fn check_finite(v: &[f32], size: usize, what: &str, unit: &str) -> PyResult<()> {
     match v.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
         Some(i) => Err(PyValueError::new_err(format!(
-            "{what}: row {} has a non-finite value ({})",
-            i / cols.max(1),
+            "{what}: {unit} {} has a non-finite value ({})",
+            i / size.max(1),
             v[i]
         ))),
     }
@@ -193,7 +194,7 @@ pub fn matrices4(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<Mat4>, boo
         [_, 4, 4] => false,
         _ => return Err(shape_error(what, "(M, 4, 4) or (4, 4)", &shape)),
     };
-    check_finite(&v, 16, what)?;
+    check_finite(&v, 16, what, "matrix")?;
     let m = v
         .chunks_exact(16)
         .map(|r| Mat4::from_cols_slice(r).transpose())
@@ -219,7 +220,7 @@ pub fn poses(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<Affine3A>, boo
         }
     };
     let size = rows * 4;
-    check_finite(&v, size, what)?;
+    check_finite(&v, size, what, "pose")?;
     v.chunks_exact(size)
         .enumerate()
         .map(|(i, m)| {

@@ -62,7 +62,7 @@ fn world_box(obj: &Bound<'_, PyAny>) -> PyResult<Aabb> {
     if !matches!(shape[..], [2, 3] | [6]) {
         return Err(arrays::shape_error("world", "(2, 3) or (6,)", &shape));
     }
-    arrays::check_finite(&v, 6, "world")?;
+    arrays::check_finite(&v, 6, "world", "box")?;
     let b = Aabb::new(vec3(&v[..3]), vec3(&v[3..]));
     b.validate().or_raise_at(|| "world".into())?;
     Ok(b)

@@ -7,7 +7,9 @@ use crate::mesh::{AnyMesh, Mesh};
 use crate::workers::Workers;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use proxima::glam::Affine3A;
-use proxima::narrow::{check_pose, BoundingVolume, Collider, CostCounters, Mesh as RsMesh, RotationUpdate};
+use proxima::narrow::{
+    check_pose, BoundingVolume, Collider, CostCounters, Mesh as RsMesh, RotationUpdate,
+};
 use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PySlice;
@@ -77,7 +79,13 @@ impl Contacts {
     }
 
     fn __bool__(&self, py: Python<'_>) -> PyResult<bool> {
-        Ok(self.colliding.bind(py).readonly().as_slice()?.iter().any(|&c| c))
+        Ok(self
+            .colliding
+            .bind(py)
+            .readonly()
+            .as_slice()?
+            .iter()
+            .any(|&c| c))
     }
 
     /// The (K_i, 2) triangle pairs of pose `i` (a view of `pairs`).

@@ -22,7 +22,11 @@ use std::io::ErrorKind;
 fn raise(e: &Error, msg: String) -> PyErr {
     match e {
         Error::Io { file, source } => {
-            let args = (source.get_ref().raw_os_error().unwrap_or(0), msg, file.clone());
+            let args = (
+                source.get_ref().raw_os_error().unwrap_or(0),
+                msg,
+                file.clone(),
+            );
             match source.kind() {
                 ErrorKind::NotFound => PyFileNotFoundError::new_err(args),
                 ErrorKind::PermissionDenied => PyPermissionError::new_err(args),
@@ -37,8 +41,9 @@ fn raise(e: &Error, msg: String) -> PyErr {
     }
 }
 
-/// [`raise`] with the error's own message (for an I/O error, the operating
-/// system's message: the path is the exception's `filename`).
+/// The exception for a library error with the error's own message (for an I/O
+/// error, the operating system's message: the path is the exception's
+/// `filename`). Which exception for which error: see `raise` in this file.
 pub fn to_py(e: Error) -> PyErr {
     let msg = match &e {
         Error::Io { source, .. } => source.to_string(),

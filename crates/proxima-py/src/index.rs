@@ -36,6 +36,12 @@ pub struct Index {
     // mask=) and a `filter=` on every query and on pairs()).
 }
 
+/// `(centers (K, 3), radii (K,))`.
+type Spheres<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f32>>);
+
+/// `(ids (M,), t (M,))` of first ray hits.
+type FirstHits<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f32>>);
+
 /// Spheres from `(n, 3)` centres and `(n,)` (or scalar) radii, each checked
 /// (finite centre, finite non-negative radius), naming the first bad row.
 fn spheres(
@@ -151,7 +157,11 @@ impl Index {
         let spheres = match (centers, radii) {
             (Some(c), Some(r)) => spheres(c, r, "spheres")?,
             (None, None) => Vec::new(),
-            _ => return Err(PyValueError::new_err("give both centers and radii, or neither")),
+            _ => {
+                return Err(PyValueError::new_err(
+                    "give both centers and radii, or neither",
+                ))
+            }
         };
         let mut hint = SceneHint::from_spheres(spheres.iter().copied(), spheres.len());
         if let Some(w) = world {
@@ -195,10 +205,17 @@ impl Index {
     }
 
     /// Stores one sphere and returns its id. O(log n) typical.
-    fn insert(&mut self, py: Python<'_>, center: &Bound<'_, PyAny>, radius: &Bound<'_, PyAny>) -> PyResult<i64> {
+    fn insert(
+        &mut self,
+        py: Python<'_>,
+        center: &Bound<'_, PyAny>,
+        radius: &Bound<'_, PyAny>,
+    ) -> PyResult<i64> {
         let s = spheres(center, radius, "sphere")?;
         if s.len() != 1 {
-            return Err(PyValueError::new_err("insert takes one sphere; use insert_many"));
+            return Err(PyValueError::new_err(
+                "insert takes one sphere; use insert_many",
+            ));
         }
         Ok(self.insert_all(py, s)?[0])
     }
@@ -321,7 +338,7 @@ impl Index {
         &self,
         py: Python<'py>,
         ids: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f32>>)> {
+    ) -> PyResult<Spheres<'py>> {
         let ids: Vec<i64> = match ids {
             Some(ids) => int_list(ids, "ids")?,
             None => self.ids(py).to_vec()?,
@@ -426,7 +443,7 @@ impl Index {
         rays: &Bound<'py, PyAny>,
         tmax: Option<&Bound<'py, PyAny>>,
         workers: i64,
-    ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f32>>)> {
+    ) -> PyResult<FirstHits<'py>> {
         let inf = f32::INFINITY.into_pyobject(py)?.into_any();
         let rs = arrays::rays(rays, tmax.unwrap_or(&inf))?;
         let workers = Workers::new(workers)?;

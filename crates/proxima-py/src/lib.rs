@@ -39,7 +39,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mesh::Mesh>()?;
     m.add_class::<collide::Contacts>()?;
     m.add_function(wrap_pyfunction!(collide::collide, m)?)?;
-    m.add("INDEX_KINDS", proxima::broad::IndexKind::ALL.map(|k| k.name()).to_vec())?;
+    m.add(
+        "INDEX_KINDS",
+        proxima::broad::IndexKind::ALL.map(|k| k.name()).to_vec(),
+    )?;
     m.add("BOUNDING_VOLUMES", mesh::BV_NAMES.to_vec())?;
     // issue #13: the collision world (`World(index=...)`, add, set_poses,
     // ignore, contacts, ray_cast) is registered here once `proxima::world`

@@ -180,6 +180,10 @@ pub fn collide(
     contacts(py, results)
 }
 
+// issue #15: `distance(a, b, poses, *, workers=1)` -> distances (N,) and the
+// closest points (N, 2, 3) over the meshes' distance queries goes beside
+// `collide` here, with the same pose handling, once `narrow/distance` lands.
+
 /// Packs per-pose results into the arrays of a [`Contacts`].
 fn contacts(py: Python<'_>, results: Vec<PoseResult>) -> PyResult<Contacts> {
     let n = results.len();

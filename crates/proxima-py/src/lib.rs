@@ -18,7 +18,7 @@
 //! Still to come, each with a marked place: k nearest neighbours, sphere
 //! sweeps and collision filters on `Index` (issue #14, in `index.rs`); the
 //! collision world `World` (issue #13, registered below); mesh distance
-//! queries (issue #15, in `mesh.rs`).
+//! queries (issue #15, in `collide.rs`).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 

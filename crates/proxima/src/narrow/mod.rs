@@ -23,6 +23,7 @@ pub(crate) mod predicates;
 mod prepared;
 mod ray_triangle;
 mod segment;
+mod sphere_triangle;
 mod tri_tri;
 mod trimesh;
 
@@ -34,5 +35,6 @@ pub use bvh::{
 pub use prepared::PreparedTriangle;
 pub use ray_triangle::{ray_triangle, TriangleHit};
 pub use segment::{segment_triangle_intersect, segments_intersect};
+pub use sphere_triangle::sphere_triangle;
 pub use tri_tri::triangles_intersect;
 pub use trimesh::TriMesh;

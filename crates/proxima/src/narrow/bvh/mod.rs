@@ -16,6 +16,7 @@
 //! - `ray.rs`: ray and segment casts on a [`Bvh`]; `ray_tree.rs` + `ray_cast.rs`:
 //!   [`RayBvh`], the same casts on a layout made for rays only; `stack.rs`: their
 //!   traversal stack; `par.rs`: parallel batches of casts (feature `parallel`);
+//! - `sphere_query.rs`: the triangles within a ball ([`Mesh::triangles_in_sphere`]);
 //! - `validate.rs`: the structural invariants.
 
 mod build;
@@ -28,6 +29,7 @@ mod ray;
 mod ray_cast;
 mod ray_tree;
 mod refit;
+mod sphere_query;
 mod stack;
 mod traverse;
 mod tree;

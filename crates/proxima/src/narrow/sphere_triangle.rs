@@ -92,7 +92,7 @@ fn face_within(p: Vec3, r: f32, tri: &[Vec3; 3]) -> bool {
     // A degenerate triangle has no face: its edges and corners are all of it.
     let normal_zero = (0..3).all(|i| {
         decide(
-            || cross::<Tracked>(&diff3(b, a), &diff3(c, a))[i].clone(),
+            || cross::<Tracked>(&diff3(b, a), &diff3(c, a))[i],
             || cross::<Exp>(&diff3(b, a), &diff3(c, a))[i].clone(),
         ) == Ordering::Equal
     });

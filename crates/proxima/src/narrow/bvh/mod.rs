@@ -37,7 +37,10 @@ mod tri_cache;
 mod validate;
 
 pub use collide::{check_pose, Collider, Contacts, CostCounters, FirstContact, RotationUpdate};
+// For the collision world: relative poses of two checked poses, and traversal cuts.
+pub(crate) use collide::rotation_deviation;
 pub use mesh::Mesh;
 pub use options::{BuildOptions, SplitRule};
 pub use ray_tree::RayBvh;
+pub(crate) use traverse::CutRecorder;
 pub use tree::{Bvh, Node};

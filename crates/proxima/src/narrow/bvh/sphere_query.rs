@@ -163,8 +163,14 @@ mod tests {
     fn bad_spheres_are_errors() {
         let (v, t) = field(2);
         let mesh = Mesh::<Kdop18>::new(v, t).unwrap();
-        assert!(mesh.triangles_in_sphere(&Sphere::new(Vec3::ZERO, -1.0)).is_err());
-        assert!(mesh.intersects_sphere(&Sphere::new(Vec3::NAN, 1.0)).is_err());
-        assert!(mesh.intersects_sphere(&Sphere::new(Vec3::ZERO, f32::INFINITY)).is_err());
+        assert!(mesh
+            .triangles_in_sphere(&Sphere::new(Vec3::ZERO, -1.0))
+            .is_err());
+        assert!(mesh
+            .intersects_sphere(&Sphere::new(Vec3::NAN, 1.0))
+            .is_err());
+        assert!(mesh
+            .intersects_sphere(&Sphere::new(Vec3::ZERO, f32::INFINITY))
+            .is_err());
     }
 }

@@ -91,7 +91,7 @@ pub struct WorldConfig {
     pub coherence: bool,
     /// The largest traversal cut (node pairs) kept per object pair for
     /// coherence; larger ones are dropped and the next test starts from the
-    /// roots. Default 48 (see `coherence.rs` for the measurements).
+    /// roots. Default 256 (see `coherence.rs` for the measurements).
     pub cut_limit: usize,
 }
 
@@ -244,7 +244,8 @@ impl<T, BV: BoundingVolume> World<T, BV> {
     /// `filter`. O(1) plus one index insert once the index is built.
     ///
     /// Fails, adding nothing, with [`Error::InvalidPose`] on a pose that is not
-    /// a rigid motion or that moves the shape beyond `f32` range, a radius error
+    /// a rigid motion or that moves the shape's bounding sphere beyond
+    /// [`COORDINATE_LIMIT`], a radius error
     /// for a `Shape::Sphere` with a negative or non-finite radius, or
     /// [`Error::CapacityExceeded`].
     pub fn insert_with_filter(
@@ -303,7 +304,7 @@ impl<T, BV: BoundingVolume> World<T, BV> {
     ///
     /// Fails, changing nothing, with [`Error::StaleHandle`] or
     /// [`Error::InvalidPose`] (not a rigid motion, non-finite, or moving the
-    /// shape beyond `f32` range).
+    /// shape beyond [`COORDINATE_LIMIT`]).
     pub fn set_pose(&mut self, handle: Handle, pose: Affine3A) -> Result<()> {
         let o = self.objects.get(handle)?;
         if o.pose == pose {
@@ -515,19 +516,25 @@ struct Posed {
 impl Posed {
     /// Checks `pose` ([`check_pose`](crate::narrow::check_pose)) and computes
     /// its inverse and the shape's broad sphere; fails with
-    /// [`Error::InvalidPose`] if either leaves `f32` range.
+    /// [`Error::InvalidPose`] if the sphere reaches beyond [`COORDINATE_LIMIT`].
     fn new<BV: BoundingVolume>(shape: &Shape<BV>, pose: &Affine3A) -> Result<Posed> {
         crate::narrow::check_pose(pose)?;
         let inverse = pose.inverse();
         let sphere = broad_sphere(&shape.local_bounding_sphere(), pose);
-        if !inverse.is_finite() || !sphere.center.is_finite() || !sphere.radius.is_finite() {
-            return Err(Error::InvalidPose(
-                "pose moves the shape beyond f32 range".into(),
-            ));
+        let reach = sphere.center.abs().max_element() + sphere.radius;
+        // NaN fails too.
+        if !inverse.is_finite() || !reach.is_finite() || reach > COORDINATE_LIMIT {
+            return Err(Error::InvalidPose(format!(
+                "pose moves the shape beyond ±{COORDINATE_LIMIT:e} (to {reach:e})"
+            )));
         }
         Ok(Posed { inverse, sphere })
     }
 }
+
+/// The largest coordinate a posed shape may reach: relative poses, slacks and
+/// index boxes computed from such coordinates stay far inside `f32` range.
+pub const COORDINATE_LIMIT: f32 = 1e30;
 
 /// Relative growth of broad-phase radii: covers the scaling by up to
 /// `1 + 1.5 · 1e-3` of a matrix that deviates from a rotation by the allowed

@@ -178,8 +178,8 @@ pub struct ObjectRef<'a, T, BV = Kdop18> {
 /// rebuild needs that many changes first, so its cost is O(1) amortized per
 /// change. Queries that take `&self` never rebuild; they stay exact.
 ///
-/// **Meshes in contact.** For a mesh pair, the mesh with fewer triangles (on a
-/// tie, the object inserted first) is moved into the frame of the other by the
+/// **Meshes in contact.** For a mesh pair, the mesh with more triangles (on a
+/// tie, the object inserted later) is moved into the frame of the other by the
 /// relative pose `pose_fixed⁻¹ · pose_moving`, and its triangles, transformed in
 /// `f32`, are tested exactly against the other's ([`Collider`]). That is the
 /// definition the answers are exact for (a brute-force oracle uses the same

@@ -43,11 +43,18 @@ pub(crate) struct PairOutcome {
 }
 
 /// Whether object `a` is the one moved into the other's frame in a mesh–mesh
-/// test: the mesh with fewer triangles moves (fewer volumes to move, and the
-/// larger tree keeps its exact volumes); on a tie, the object inserted first.
+/// test: the mesh with more triangles moves (on a tie, the object inserted
+/// later). Measured with callgrind (`run_from`, k-DOP18 with the conservative
+/// rotation update; OBB is indifferent): moving the larger mesh costs 18 % fewer
+/// instructions on 120 bunnies, teapots and robs at random poses (Nv 3.05 M
+/// instead of 5.07 M, Np 0.58 M instead of 1.43 M, Nu 0.39 M instead of
+/// 0.22 M) and 12 % fewer on SKINbody turned through BONERibcage: the
+/// conservatively moved volumes are loose, and they hurt less on the many small
+/// nodes of the larger tree than on the few large nodes of the smaller one,
+/// which keeps its exact volumes when it stays fixed.
 #[inline]
 pub(crate) fn a_moves(tri_a: usize, seq_a: u64, tri_b: usize, seq_b: u64) -> bool {
-    (tri_a, seq_a) < (tri_b, seq_b)
+    (tri_a, seq_a) > (tri_b, seq_b)
 }
 
 /// Tests objects `a` and `b` (`a` the one with the smaller handle) and appends

@@ -3,8 +3,8 @@
 //! (`triangles_intersect`, `sphere_triangle`, `ray_triangle`, the sphere tests),
 //! each checked against exact arithmetic in its own suite. It shares no code
 //! with `proxima::world`; it applies the same definition: a mesh pair is tested
-//! in the frame of the mesh with more triangles (on a tie, of the object
-//! inserted later), the other moved by `pose_fixed⁻¹ · pose_moving` in `f32`.
+//! in the frame of the mesh with fewer triangles (on a tie, of the object
+//! inserted first), the other moved by `pose_fixed⁻¹ · pose_moving` in `f32`.
 //!
 //! Box pre-checks (comparisons of the very `f32` corners that the exact tests
 //! receive) change no answer: a shared point lies in both boxes.
@@ -171,7 +171,7 @@ impl BruteWorld {
 fn pair(a: &BObj, b: &BObj) -> Vec<(u32, u32)> {
     let mut out = match (&a.shape, &b.shape) {
         (BShape::Mesh(ma), BShape::Mesh(mb)) => {
-            let a_moves = (ma.triangles.len(), a.seq) < (mb.triangles.len(), b.seq);
+            let a_moves = (ma.triangles.len(), a.seq) > (mb.triangles.len(), b.seq);
             if a_moves {
                 mesh_pairs(ma, &a.pose, mb, &b.pose)
             } else {

@@ -41,7 +41,7 @@ use rustc_hash::FxHashMap;
 use std::ops::Range;
 
 /// Default [`WorldConfig::cut_limit`](super::WorldConfig::cut_limit).
-pub(crate) const DEFAULT_CUT_LIMIT: usize = 256;
+pub(crate) const DEFAULT_CUT_LIMIT: usize = 1024;
 
 /// Largest accepted cut limit.
 pub(crate) const MAX_CUT_LIMIT: usize = 1 << 20;

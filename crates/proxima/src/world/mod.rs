@@ -91,7 +91,7 @@ pub struct WorldConfig {
     pub coherence: bool,
     /// The largest traversal cut (node pairs) kept per object pair for
     /// coherence; larger ones are dropped and the next test starts from the
-    /// roots. Default 256 (see `coherence.rs` for the measurements).
+    /// roots. Default 1024 (see `coherence.rs` for the measurements).
     pub cut_limit: usize,
 }
 

@@ -125,8 +125,10 @@ impl Terminal for CutRecorder<'_> {
 /// the larger" refinement); a pair of overlapping leaves goes to
 /// `leaf(a_node, b_node)`, which returns true to stop. Pairs not split are
 /// reported to `cut`. Each pair of leaves is reached at most once, so each
-/// triangle pair is tested at most once. Counts volume tests in `nv`. Returns true
-/// if stopped early (then `cut` saw only part of the cut).
+/// triangle pair is tested at most once. A start other than the roots is
+/// preceded by a test of the roots, which ends the traversal when they are
+/// disjoint. Counts volume tests in `nv`. Returns true if stopped early (then
+/// `cut` saw only part of the cut).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn traverse<BV: BoundingVolume>(
     a: &Bvh<BV>,
@@ -139,6 +141,15 @@ pub(crate) fn traverse<BV: BoundingVolume>(
     mut leaf: impl FnMut(usize, usize) -> bool,
 ) -> bool {
     stack.clear();
+    if start != [(0, 0)] {
+        // A cut from an earlier pose: if the roots are now disjoint, so is every
+        // pair below them (one test instead of one per pair of the cut).
+        *nv += 1;
+        if !src.overlaps(0, &b.nodes[0].bv) {
+            cut.reached(0, 0);
+            return false;
+        }
+    }
     stack.extend(start.iter().rev());
     while let Some((ia, ib)) = stack.pop() {
         let nb = &b.nodes[ib as usize];

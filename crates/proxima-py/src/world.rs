@@ -279,7 +279,12 @@ impl World {
         filter: Filter,
         single: bool,
     ) -> PyResult<Vec<i64>> {
-        let mesh = shape.cast::<Mesh>().ok().map(|m| m.borrow());
+        // try_borrow: a mesh being changed on another thread raises, never panics.
+        let mesh = shape
+            .cast::<Mesh>()
+            .ok()
+            .map(|m| m.try_borrow())
+            .transpose()?;
         let arg = match &mesh {
             Some(m) => ShapeArg::Mesh(&m.inner),
             None => ShapeArg::Ball(shape.extract::<f32>().map_err(|_| {

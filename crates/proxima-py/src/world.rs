@@ -475,6 +475,19 @@ impl World {
         Ok(())
     }
 
+    /// Removes every object of `ids` (and their ignored pairs). All or
+    /// nothing: KeyError, removing nothing, if one is not in the world or
+    /// appears twice.
+    fn remove_many(&mut self, ids: &Bound<'_, PyAny>) -> PyResult<()> {
+        let ids = int_list(ids, "ids")?;
+        let hs = self.ids.handles_of(&ids)?;
+        for (id, h) in ids.into_iter().zip(hs) {
+            each_world!(&mut self.inner, w => w.remove(h).or_raise())?;
+            self.ids.forget(id);
+        }
+        Ok(())
+    }
+
     /// Moves one object to `pose` ((4, 4) or (3, 4) rigid). KeyError for an
     /// id not in the world; ValueError on a non-rigid or non-finite pose.
     /// Nothing changes on error. O(1) plus one index update.

@@ -161,6 +161,13 @@ def test_ids_are_insertion_order_and_never_reused():
         rel = np.linalg.inv(w.pose(b).astype(np.float64)) @ w.pose(a)
         want, unsure = brute.mesh_pairs(TET_V, TET_F, TET_V, TET_F, rel)
         assert want <= set(tris) <= want | unsure and tris == sorted(tris), (a, b)
+    with pytest.raises(KeyError, match="id 4 appears twice"):
+        w.remove_many([4, 4])
+    with pytest.raises(KeyError, match="id 1 is not in the world"):
+        w.remove_many([4, 1])
+    assert len(w) == 4
+    w.remove_many(np.array([5, 3]))
+    assert w.ids().tolist() == [0, 4] and sorted(as_dict(w.contacts())) == [(0, 4)]
 
 
 def test_a_shared_mesh_is_not_copied():

@@ -446,6 +446,10 @@ class World:
     def remove(self, id: int) -> None:
         """Removes an object and its ignored pairs. KeyError if absent."""
 
+    def remove_many(self, ids: ArrayLike) -> None:
+        """Removes every object of ``ids``. All or nothing: KeyError if one is
+        absent or appears twice."""
+
     def set_pose(self, id: int, pose: ArrayLike) -> None:
         """Moves one object. KeyError / ValueError, changing nothing."""
 

@@ -5,7 +5,7 @@
 //!
 //! `proxima-bench w5 [--poses FILE] [--pairs rob-env,bunny,...] [--n N] [--seed S]
 //! [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall]
-//! [--peers auto|none] [--peer-reps R] [--json]`
+//! [--peers auto|none] [--peer-reps R] [--write-poses DIR] [--json]`
 //!
 //! - `rob-env` (FCL's test: rob.obj moving, env.obj fixed) uses the pose file
 //!   (default `data/rob-env-1000.poses`, FCL's distribution); `skin-ribcage`
@@ -18,6 +18,8 @@
 //!   `Nv/Np/Nu` of the all-pairs query, the intersecting triangle pairs summed
 //!   over poses, and the poses with a contact. The same for every peer (the C++
 //!   peers' times are the harness's wall-clock figures over poses × `--peer-reps`).
+//! - `--write-poses DIR` also writes each pair's poses to `DIR/PAIR.poses` (for
+//!   `proxima collide --poses` and the peers' harness, e.g. under callgrind).
 //! - Checked in the same run (exit code 1 otherwise): every bounding volume finds
 //!   the same number of pairs on every pose; first contact hits iff all pairs is
 //!   non-empty; on the first `--brute` poses (fewer on big pairs, so that at most
@@ -42,7 +44,7 @@ use std::fmt::Write as _;
 use std::process::ExitCode;
 use std::time::Duration;
 
-const USAGE: &str = "usage: proxima-bench w5 [--poses FILE] [--pairs rob-env,bunny,teapot,hand-forearm,skin-ribcage] [--n N] [--seed S] [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall] [--peers auto|none] [--peer-reps R] [--json]";
+const USAGE: &str = "usage: proxima-bench w5 [--poses FILE] [--pairs rob-env,bunny,teapot,hand-forearm,skin-ribcage] [--n N] [--seed S] [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall] [--peers auto|none] [--peer-reps R] [--write-poses DIR] [--json]";
 
 /// The mesh pairs: name, moving mesh, fixed mesh (files in `shared/data/`).
 const PAIRS: [(&str, &str, &str); 5] = [
@@ -68,6 +70,7 @@ const BRUTE_BUDGET: usize = 100_000_000;
 
 struct Args {
     poses: String,
+    write_poses: Option<String>,
     pairs: Vec<String>,
     n: Option<usize>,
     seed: u64,
@@ -82,6 +85,7 @@ struct Args {
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     let mut a = Args {
         poses: DEFAULT_POSES.into(),
+        write_poses: None,
         pairs: DEFAULT_PAIRS.split(',').map(String::from).collect(),
         n: None,
         seed: 5,
@@ -101,6 +105,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         let mut value = |name: &str| it.next().ok_or(format!("{name} needs a value"));
         match flag.as_str() {
             "--poses" => a.poses = value("--poses")?,
+            "--write-poses" => a.write_poses = Some(value("--write-poses")?),
             "--pairs" => {
                 a.pairs = value("--pairs")?
                     .split(',')
@@ -199,11 +204,20 @@ fn run_pair(
         "skin-ribcage" => poses::generate_nested(&a, &b, n, args.seed),
         _ => poses::generate(&a, &b, n, args.seed),
     };
+    if let Some(dir) = &args.write_poses {
+        let path = std::path::Path::new(dir).join(format!("{name}.poses"));
+        peers::write_poses(&path, &poses)?;
+        eprintln!("  {name}: wrote {}", path.display());
+    }
     let brute_poses = args
         .brute
         .min(BRUTE_BUDGET / (a.len() * b.len()))
         .min(poses.len());
-    let (c, k, r) = (args.clock, brute_poses, args.rotation);
+    let (c, k, r) = (
+        ours::QueryClock::new(args.clock),
+        brute_poses,
+        args.rotation,
+    );
     let mut bvs = Vec::new();
     for bv in ["aabb", "kdop14", "kdop18", "kdop26", "obb", "sphere"] {
         eprintln!("  {name}: {bv} ...");
@@ -250,7 +264,7 @@ fn run_pair(
         }
     }
     eprintln!("  {name}: parry3d ...");
-    let parry = run_parry(&a, &b, &poses, reference, args.clock)?;
+    let parry = run_parry(&a, &b, &poses, reference, c)?;
     if parry.d.unverified > 0 {
         errors.push(format!(
             "{name}: {} disagreements with parry not confirmed by the exact test",
@@ -320,9 +334,9 @@ fn run_parry(
     b: &TriMesh,
     poses: &[Affine3A],
     ours: &BvRun,
-    clock: Clock,
+    qc: ours::QueryClock,
 ) -> Result<ParryRun, String> {
-    let (meshes, build) = clock.time(|| ParryMeshes::build(a, b));
+    let (meshes, build) = qc.clock.time(|| ParryMeshes::build(a, b));
     let meshes = meshes?;
     let mut r = ParryRun {
         build,
@@ -340,11 +354,11 @@ fn run_parry(
     let mut col = proxima::narrow::Collider::<Obb>::default();
     for (i, p) in poses.iter().enumerate() {
         let pp = parry_mesh::pose(p);
-        let (hit, t) = clock.time(|| meshes.intersects(&pp));
+        let (hit, t) = qc.time(|| meshes.intersects(&pp));
         let hit = hit?;
         r.first.push(t);
         r.hits += hit as usize;
-        let (mut pairs, t) = clock.time(|| meshes.all_pairs(&pp));
+        let (mut pairs, t) = qc.time(|| meshes.all_pairs(&pp));
         r.all.push(t);
         r.pair_total += pairs.len() as u64;
         pairs.sort_unstable();
@@ -423,7 +437,7 @@ fn denominators(p: &PairRun) -> [(f64, String); 4] {
 
 fn table(runs: &[PairRun], rotation: RotationUpdate, clock: Clock) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "w5 mesh vs mesh, SAH trees (leaf 1), rotation={:?}, clock={} for ours and parry3d, wall for the C++ peers (their harness); times in µs per query; /best = ours over the fastest peer of this run on that statistic; pair counts checked equal for every BV on every pose", rotation, clock.name());
+    let _ = writeln!(s, "w5 mesh vs mesh, SAH trees (leaf 1), rotation={:?}, clock={} for ours and parry3d, wall for the C++ peers (their harness); times in µs per query (the clock's own cost beyond a wall-clock reading removed); /best = ours over the fastest peer of this run on that statistic; pair counts checked equal for every BV on every pose", rotation, clock.name());
     for p in runs {
         let d = denominators(p);
         let _ = writeln!(

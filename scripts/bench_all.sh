@@ -19,6 +19,8 @@ $B w4 --threads 1 --clock wall --only UniformGrid3d,LinearOctree,LooseKdTree,rst
 uptime >> $D/load.txt
 $B w5 > $D/w5.txt 2>/dev/null
 $B w5 --json > $D/w5.json 2>/dev/null
+# W6 runs Embree beside ours when scripts/peers.sh has built target/peers/w6_rays.
+[ -x target/peers/w6_rays ] || echo "bench_all: no target/peers/w6_rays (scripts/peers.sh): W6 without Embree" >&2
 $B w6 > $D/w6.txt 2>/dev/null
 $B w6 --json > $D/w6.json 2>/dev/null
 uptime >> $D/load.txt

@@ -22,6 +22,8 @@ uptime >> $D/load.txt
 # table says so otherwise); wall clock, as their harness measures.
 $B w5 --clock wall > $D/w5.txt 2>/dev/null
 $B w5 --clock wall --json > $D/w5.json 2>/dev/null
+# W6 runs Embree beside ours when scripts/peers.sh has built target/peers/w6_rays.
+[ -x target/peers/w6_rays ] || echo "bench_all: no target/peers/w6_rays (scripts/peers.sh): W6 without Embree" >&2
 $B w6 > $D/w6.txt 2>/dev/null
 $B w6 --json > $D/w6.json 2>/dev/null
 uptime >> $D/load.txt

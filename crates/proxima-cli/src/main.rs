@@ -5,6 +5,7 @@
 
 mod collide;
 mod demo;
+mod demo_world;
 mod draw;
 mod indices;
 mod pictures;
@@ -14,6 +15,7 @@ mod scene;
 mod trace;
 mod world;
 mod world_oracle;
+mod world_picture;
 mod world_replay;
 mod world_trace;
 

@@ -6,16 +6,23 @@
 //! tie, the object added later) is moved into the other's frame by
 //! `pose_fixed⁻¹ · pose_moving`, computed in `f32`.
 //!
-//! Triangle pairs are found by sweeping the triangles' boxes along x (sort and
-//! sweep), then deciding every pair of overlapping boxes exactly. The boxes are
-//! those of the very `f32` corners the exact test receives and two triangles
-//! that share a point have overlapping boxes, so this changes no answer; it
-//! only makes meshes of tens of thousands of triangles affordable.
+//! Two shortcuts keep it affordable without changing an answer. An object pair
+//! is skipped when the world boxes of the two meshes' local boxes, moved by
+//! their poses and grown by a margin far above the rounding of either frame
+//! (`1e-3` of the coordinates' magnitude), are disjoint: posed meshes that
+//! share a point have overlapping boxes; a ray skips an object whose grown box
+//! it misses (the conservative `ray_aabb`). Triangle pairs are found by sweeping
+//! the triangles' boxes along x (sort and sweep), then deciding every pair of
+//! overlapping boxes exactly; those boxes are of the very `f32` corners the
+//! exact test receives, and two triangles that share a point have overlapping
+//! boxes. Hundreds of objects and meshes of tens of thousands of triangles stay
+//! affordable.
 
 use crate::world_replay::WorldAnswer;
 use crate::world_trace::{WorldOp, WorldTrace};
-use proxima::geom::Ray;
-use proxima::glam::{Affine3A, Vec3};
+use proxima::geom::overlap::ray_aabb;
+use proxima::geom::{Aabb, Ray};
+use proxima::glam::{Affine3A, BVec3, Vec3};
 use proxima::narrow::{ray_triangle, sphere_triangle, triangles_intersect};
 use std::collections::HashSet;
 
@@ -52,6 +59,8 @@ pub struct BruteWorld<'t> {
     trace: &'t WorldTrace,
     /// Each mesh's triangles in its own frame, sorted by `lo.x`.
     local: Vec<Vec<Boxed>>,
+    /// Each mesh's box in its own frame.
+    bounds: Vec<(Vec3, Vec3)>,
     objects: Vec<Option<Obj>>,
     ignored: HashSet<(u32, u32)>,
     seq: u64,
@@ -72,10 +81,20 @@ impl<'t> BruteWorld<'t> {
                 v.sort_by(|a, b| a.lo.x.total_cmp(&b.lo.x));
                 v
             })
+            .collect::<Vec<Vec<Boxed>>>();
+        let bounds = local
+            .iter()
+            .map(|tris| {
+                tris.iter()
+                    .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), t| {
+                        (lo.min(t.lo), hi.max(t.hi))
+                    })
+            })
             .collect();
         BruteWorld {
             trace,
             local,
+            bounds,
             objects: vec![None; trace.ids.len()],
             ignored: HashSet::new(),
             seq: 0,
@@ -124,12 +143,32 @@ impl<'t> BruteWorld<'t> {
             .filter_map(|(i, o)| o.as_ref().map(|o| (i as u32, o)))
     }
 
+    /// The world box of an object's posed local box, grown by the margin (see
+    /// the module's documentation).
+    fn world_box(&self, o: &Obj) -> (Vec3, Vec3) {
+        let (lo, hi) = self.bounds[o.mesh as usize];
+        let (mut wlo, mut whi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for i in 0..8 {
+            let c = Vec3::select(BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo);
+            let p = o.pose.transform_point3(c);
+            (wlo, whi) = (wlo.min(p), whi.max(p));
+        }
+        let magnitude = wlo.abs().max(whi.abs()).max_element() + (whi - wlo).max_element();
+        let m = Vec3::splat(1e-3 * magnitude + f32::MIN_POSITIVE);
+        (wlo - m, whi + m)
+    }
+
     fn contacts(&self) -> WorldAnswer {
         let live: Vec<(u32, &Obj)> = self.live().collect();
+        let boxes: Vec<(Vec3, Vec3)> = live.iter().map(|(_, o)| self.world_box(o)).collect();
         let (mut pairs, mut tris) = (0, 0);
         for (i, &(sa, a)) in live.iter().enumerate() {
-            for &(sb, b) in &live[i + 1..] {
+            for (j, &(sb, b)) in live.iter().enumerate().skip(i + 1) {
                 if self.ignored.contains(&(sa.min(sb), sa.max(sb))) {
+                    continue;
+                }
+                let ((alo, ahi), (blo, bhi)) = (boxes[i], boxes[j]);
+                if !(alo.cmple(bhi).all() && blo.cmple(ahi).all()) {
                     continue;
                 }
                 let n = self.pair(a, b);
@@ -162,6 +201,10 @@ impl<'t> BruteWorld<'t> {
     fn ray(&self, ray: &Ray) -> Option<(u64, u32)> {
         let mut best: Option<(f32, u64, u32)> = None;
         for (slot, o) in self.live() {
+            let (lo, hi) = self.world_box(o);
+            if ray_aabb(ray, &Aabb::new(lo, hi)).is_none() {
+                continue;
+            }
             let inv = o.pose.inverse();
             let local = Ray::with_max_t(
                 inv.transform_point3(ray.origin),

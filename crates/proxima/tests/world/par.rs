@@ -3,6 +3,19 @@
 use super::oracle::Sim;
 use proxima::narrow::{Kdop18, Obb};
 use proxima::world::{ContactMode, ContactReport, WorldConfig};
+use proxima::Handle;
+
+/// A report with each handle as `(slot, generation)`: two worlds' handles carry
+/// different structure tags, the slots and generations are comparable.
+fn slots(r: &ContactReport) -> impl PartialEq + std::fmt::Debug + '_ {
+    let h = |h: Handle| (h.index(), h.generation());
+    let pairs: Vec<_> = r
+        .pairs
+        .iter()
+        .map(|c| (h(c.a), h(c.b), c.triangles.clone()))
+        .collect();
+    (pairs, &r.triangles, r.counters)
+}
 
 #[test]
 fn parallel_contacts_equal_sequential() {
@@ -22,7 +35,7 @@ fn parallel_contacts_equal_sequential() {
             let mut b = ContactReport::default();
             seq.world.contacts_into(mode, &mut a).unwrap();
             par.world.par_contacts_into(mode, &mut b).unwrap();
-            assert_eq!(a, b);
+            assert_eq!(slots(&a), slots(&b));
             pairs += a.pairs.len();
         }
     }
@@ -34,5 +47,5 @@ fn parallel_contacts_equal_sequential() {
     let a = o.world.par_contacts().unwrap();
     o.world.validate().unwrap();
     let b = o.world.contacts().unwrap();
-    assert_eq!((a.pairs, a.triangles), (b.pairs, b.triangles));
+    assert_eq!((a.pairs, a.triangles), (b.pairs, b.triangles), "one world");
 }

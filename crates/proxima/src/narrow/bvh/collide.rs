@@ -3,7 +3,7 @@
 //! counters of [sources: bvh-cost].
 
 use super::mesh::Mesh;
-use super::traverse::{traverse, Lazy, Local, Precomputed, Terminal};
+use super::traverse::{traverse, ExactLeaves, Lazy, Local, Precomputed, Terminal};
 use super::tri_cache::{QueryCache, TriangleCache};
 use crate::narrow::bv::{slack_for, BoundingVolume};
 use crate::narrow::PreparedTriangle;
@@ -291,8 +291,21 @@ impl<BV: BoundingVolume> Collider<BV> {
             false
         };
         let moved = |v: u32| pose.transform_point3(va[v as usize]);
-        let stopped;
-        if BV::AXIS_ALIGNED && rotated {
+        // The descent, ordered deepest overlap first for a first contact.
+        macro_rules! go {
+            ($src:expr, $corner:expr) => {
+                if first {
+                    traverse::<BV, true>(ta, $src, tb, start, stack, &mut c.nv, cut, |x, y| {
+                        leaf($corner, x, y)
+                    })
+                } else {
+                    traverse::<BV, false>(ta, $src, tb, start, stack, &mut c.nv, cut, |x, y| {
+                        leaf($corner, x, y)
+                    })
+                }
+            };
+        }
+        let stopped = if BV::AXIS_ALIGNED && rotated {
             let update = match *rotation {
                 RotationUpdate::Auto => RotationUpdate::Conservative,
                 r => r,
@@ -304,30 +317,25 @@ impl<BV: BoundingVolume> Collider<BV> {
                     c.nu = ta.world_volumes(world_vertices, slack, world);
                     let wv: &[Vec3] = world_vertices;
                     let corner = |v: u32| wv[v as usize];
-                    stopped = traverse(
-                        ta,
-                        &mut Precomputed(world),
-                        tb,
-                        start,
-                        stack,
-                        &mut c.nv,
-                        cut,
-                        |x, y| leaf(&corner, x, y),
-                    );
+                    go!(&mut Precomputed(world), &corner)
                 }
                 _ => {
                     cache.begin(ta.nodes.len(), ta.nodes[0].bv);
-                    let mut src = Lazy {
-                        nodes: &ta.nodes,
-                        pose: *pose,
-                        slack,
-                        cache,
-                        updates: 0,
+                    let mut src = ExactLeaves {
+                        lazy: Lazy {
+                            nodes: &ta.nodes,
+                            pose: *pose,
+                            slack,
+                            cache,
+                            updates: 0,
+                        },
+                        tris: &ta.tris,
+                        vertices: va,
+                        sizes: &ta.subtree,
                     };
-                    stopped = traverse(ta, &mut src, tb, start, stack, &mut c.nv, cut, |x, y| {
-                        leaf(&moved, x, y)
-                    });
-                    c.nu = src.updates;
+                    let stopped = go!(&mut src, &moved);
+                    c.nu = src.lazy.updates;
+                    stopped
                 }
             }
         } else {
@@ -335,10 +343,8 @@ impl<BV: BoundingVolume> Collider<BV> {
                 nodes: &ta.nodes,
                 motion: BV::motion(pose, slack),
             };
-            stopped = traverse(ta, &mut src, tb, start, stack, &mut c.nv, cut, |x, y| {
-                leaf(&moved, x, y)
-            });
-        }
+            go!(&mut src, &moved)
+        };
         c.np = np;
         (c, stopped)
     }

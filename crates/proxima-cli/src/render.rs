@@ -13,12 +13,12 @@
 
 use crate::collide::parse_poses;
 use crate::draw::Canvas;
-use crate::indices::SceneHint;
 use crate::pictures;
-use crate::trace::{Op, Trace};
+use proxima::broad::SceneHint;
 use proxima::geom::Sphere;
 use proxima::glam::Affine3A;
 use proxima::narrow::Mesh;
+use proxima_harness::trace::{Op, Trace};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

@@ -12,6 +12,7 @@
 //! | [`trace`] | the scene trace of `proxima replay` [sources: trace-format] | CLI, `replay` fuzz target |
 //! | [`replay`] | a trace run on an index, answers compared with brute force | CLI, `replay` fuzz target |
 //! | [`ops`] | operation sequences decoded from bytes, every index against brute force | `tests/ops`, `index_ops` fuzz target |
+//! | [`poses`] | the pose-file format (12 numbers a line) | `proxima collide`, `proxima render`, W5 bench |
 //! | [`oracle`] | long random sequences on one index against brute force; [`oracle::make_index`] | `tests/oracle`, `tests/loose_kd*.rs`, `tests/extreme.rs` |
 //! | [`tri_tri`] | the exact triangle–triangle reference | `tests/tri_tri`, `tri_tri` fuzz target |
 //!
@@ -35,6 +36,7 @@ pub mod indices;
 pub mod lex;
 pub mod ops;
 pub mod oracle;
+pub mod poses;
 pub mod replay;
 pub mod trace;
 pub mod tri_tri;

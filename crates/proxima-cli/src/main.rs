@@ -1,23 +1,19 @@
 //! `proxima`: the command-line tool of the Proxima library [sources: cli].
 //!
 //! This file only parses arguments and dispatches; each command lives in its own
-//! module, and the broad-phase indices they run are listed once in [`indices`].
+//! module. What the commands share with the benchmarks, fuzz targets and tests
+//! (the index names, the scene generators, the trace parser and replay engine) is
+//! in the `proxima-harness` crate.
 
 mod collide;
 mod demo;
 mod demo_world;
 mod draw;
-mod indices;
 mod pictures;
 mod render;
 mod replay;
-mod scene;
-mod trace;
 mod world;
-mod world_oracle;
 mod world_picture;
-mod world_replay;
-mod world_trace;
 
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};

@@ -14,6 +14,9 @@
 //! - [`w5`]: the mesh-vs-mesh workload W5 and its peer [`parry_mesh`];
 //! - [`w6`]: rays vs one mesh (its own runner, table and agreement check), with
 //!   its peers (obvhs, bvh, parry3d's `TriMesh`) beside it, as W4's are;
+//! - [`world`]: the collision world's scenes (tumble, arms, deep
+//!   interpenetration, churn) as world traces, on Proxima's world and on FCL's
+//!   through the `fcl_world` harness in the same run;
 //! - [`run`]: timing and the pair-count ledger; [`report`]: tables and JSON;
 //! - [`chart`]: an SVG bar chart of any workload's `--json` output.
 //!
@@ -31,3 +34,4 @@ pub mod structure;
 pub mod w4;
 pub mod w5;
 pub mod w6;
+pub mod world;

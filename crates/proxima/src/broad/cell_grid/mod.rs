@@ -22,6 +22,9 @@ mod ray;
 mod store;
 mod validate;
 
+#[cfg(test)]
+mod tests;
+
 pub(crate) use dense::Dense;
 pub(crate) use hashed::Hashed;
 pub(crate) use store::Store;

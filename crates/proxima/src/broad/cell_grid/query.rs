@@ -50,7 +50,7 @@ use std::ops::ControlFlow;
 const FLAT_CELLS: u64 = 64;
 
 /// Blocks of at most this many cells are not split further.
-const LEAF_CELLS: u64 = 8;
+const LEAF_CELLS: u64 = 16;
 
 impl<T, S: Store> CellGrid<T, S> {
     /// Reports every object `q` selects, each once: a ray walks its cells

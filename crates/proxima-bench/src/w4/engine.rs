@@ -3,7 +3,7 @@
 //!
 //! Every answer is exact and closed: a peer's own traversal yields candidates
 //! (AABB, ray or point-radius hits), and the same tests of `proxima::geom::overlap`
-//! (through [`Selection::selects`]) filter them, so hit counts are comparable.
+//! (through `Selection::selects`) filter them, so hit counts are comparable.
 
 use super::queries::{Batches, QueryKind};
 use proxima::broad::{par_query_counts, AnyIndex, Query, SpatialIndex};
@@ -145,7 +145,7 @@ impl Engine for Proxima {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::workloads::{Kind, Workload};
+    use proxima_harness::workloads::{Kind, Workload};
 
     #[test]
     fn morton_order_is_a_permutation_that_keeps_neighbours_close() {

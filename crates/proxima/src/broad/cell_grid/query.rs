@@ -130,8 +130,7 @@ impl<T, S: Store> CellGrid<T, S> {
             Within::Empty => return ControlFlow::Continue(()),
             Within::Many => {}
         }
-        let (centres, loose) = self.report_boxes(&region, kb);
-        let (rel, mask) = q.classify_centres(&centres, &loose, mask);
+        let (rel, mask) = self.classify(q, kb, &region, mask);
         match rel {
             Relation::Outside => ControlFlow::Continue(()),
             Relation::Inside => self
@@ -143,6 +142,20 @@ impl<T, S: Store> CellGrid<T, S> {
                 self.descend_blocks(q, kb, high, mask, f)
             }
         }
+    }
+
+    /// `q` against the objects that the cells `region` report for a query
+    /// over `kb`, over the planes in `mask`.
+    #[inline]
+    fn classify<Q: Selection + ?Sized>(
+        &self,
+        q: &Q,
+        kb: &KeyBox,
+        region: &KeyBox,
+        mask: u8,
+    ) -> (Relation, u8) {
+        let (centres, loose) = self.report_boxes(region, kb);
+        q.classify_centres(&centres, &loose, mask)
     }
 
     /// Reports every reference of cell `key` that a query over `kb` reports
@@ -177,8 +190,7 @@ impl<T, S: Store> CellGrid<T, S> {
         if !self.store.any_in(block, &region) {
             return ControlFlow::Continue(());
         }
-        let (centres, loose) = self.report_boxes(&region, kb);
-        let (rel, mask) = q.classify_centres(&centres, &loose, mask);
+        let (rel, mask) = self.classify(q, kb, &region, mask);
         match rel {
             Relation::Outside => ControlFlow::Continue(()),
             Relation::Inside => self

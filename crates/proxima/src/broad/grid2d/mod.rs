@@ -88,9 +88,9 @@ impl Grid2dConfig {
 /// **Not for deep worlds — no query kind.** Each cell is a column through all
 /// of z, so in a world as deep as it is wide every query tests every object
 /// in the columns it covers, however far in z. On W4 (100 000 spheres in a
-/// cube, `proxima-bench w4`) its sphere and box queries take about 3×, its
-/// rays 2.6× and its frusta 4.7× the time of rstar's R-tree, and that gap
-/// grows with the depth. For such worlds use [`HashGrid`](super::HashGrid) or
+/// cube, `proxima-bench w4`, a shared machine) its sphere and box queries
+/// took 3–4×, its rays 2.6–3.2× and its frusta 4.6–4.8× the time of rstar's
+/// R-tree, and that gap grows with the depth. For such worlds use [`HashGrid`](super::HashGrid) or
 /// [`UniformGrid3d`](super::UniformGrid3d); this grid is for flat ones (W2),
 /// where a column holds few objects.
 ///

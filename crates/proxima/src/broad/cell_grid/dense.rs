@@ -2,7 +2,7 @@
 
 use super::keys::{Key, KeyBox, Lattice};
 use super::list::{CellList, Rect};
-use super::store::{Entries, Store};
+use super::store::{Entries, Store, Within};
 use std::ops::ControlFlow;
 
 /// A dense array of cells over the keys `lattice.limits` (z flat).
@@ -125,6 +125,22 @@ impl Store for Dense {
             return ControlFlow::Continue(());
         }
         f(kb, ())
+    }
+
+    /// The whole rectangle is one block.
+    #[inline]
+    fn within(&self, _: &KeyBox) -> Within<()> {
+        Within::One(())
+    }
+
+    #[inline]
+    fn split(&self, region: &KeyBox) -> (KeyBox, KeyBox) {
+        region.halves()
+    }
+
+    #[inline]
+    fn descent_is_bounded(&self, _: &KeyBox) -> bool {
+        true
     }
 
     #[inline]

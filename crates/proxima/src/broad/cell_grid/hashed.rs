@@ -9,7 +9,7 @@
 
 use super::keys::{Key, KeyBox, Lattice};
 use super::list::{CellList, Cube};
-use super::store::{Entries, Store};
+use super::store::{Entries, Store, Within};
 use rustc_hash::FxHashMap;
 use std::ops::ControlFlow;
 
@@ -332,6 +332,42 @@ impl Store for Hashed {
         f: impl FnMut(KeyBox, u32) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         self.each_block(kb, f)
+    }
+
+    #[inline]
+    fn within(&self, region: &KeyBox) -> Within<u32> {
+        let (lo, hi) = (region.lo.map(|c| c >> SHIFT), region.hi.map(|c| c >> SHIFT));
+        if lo != hi {
+            return Within::Many;
+        }
+        match self.map.get(&lo) {
+            Some(&bi) => Within::One(bi),
+            None => Within::Empty,
+        }
+    }
+
+    #[inline]
+    fn split(&self, region: &KeyBox) -> (KeyBox, KeyBox) {
+        let (lo, hi) = (region.lo.map(|c| c >> SHIFT), region.hi.map(|c| c >> SHIFT));
+        let a = (0..3).max_by_key(|&a| hi[a] - lo[a]).unwrap_or(0);
+        // The first block of the upper half; `< 2^28` in magnitude, so the
+        // shift stays within the keys' range.
+        let first = (lo[a] + hi[a]).div_euclid(2) + 1;
+        let (mut low, mut high) = (*region, *region);
+        low.hi[a] = (first << SHIFT) - 1;
+        high.lo[a] = first << SHIFT;
+        (low, high)
+    }
+
+    /// At most 8 blocks of the key box per occupied block: the descent then
+    /// classifies O(occupied blocks) parts.
+    #[inline]
+    fn descent_is_bounded(&self, kb: &KeyBox) -> bool {
+        let blocks = KeyBox {
+            lo: kb.lo.map(|c| c >> SHIFT),
+            hi: kb.hi.map(|c| c >> SHIFT),
+        };
+        blocks.volume() <= 8 * self.live_blocks() as u64 + 8
     }
 
     #[inline]

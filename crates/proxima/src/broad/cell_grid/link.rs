@@ -100,8 +100,7 @@ impl<T, S: Store> CellGrid<T, S> {
     fn drop_oversized(&mut self, i: u32) {
         self.oversized.swap_remove(i as usize);
         if let Some(&moved) = self.oversized.get(i as usize) {
-            let h = self.handles[moved as usize];
-            if let Ok(item) = self.items.get_mut(h) {
+            if let Some(item) = self.items.get_by_index_mut(moved) {
                 item.place = Place::Oversized(i);
             }
         }

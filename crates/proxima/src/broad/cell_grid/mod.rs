@@ -22,6 +22,9 @@ mod ray;
 mod store;
 mod validate;
 
+#[cfg(test)]
+mod tests;
+
 pub(crate) use dense::Dense;
 pub(crate) use hashed::Hashed;
 pub(crate) use store::Store;
@@ -64,9 +67,9 @@ pub(crate) struct CellGrid<T, S: Store> {
     store: S,
     items: Arena<Item<T, S::Packed>>,
     /// Slot → sphere of the live object there (hot data for pairs and queries).
+    /// A reference's handle and payload come from the arena slot itself (one
+    /// memory access per hit, not two).
     spheres: Vec<Sphere>,
-    /// Slot → live handle, to report a handle from a reference.
-    handles: Vec<Handle>,
     /// Growing bounds on the gridded spheres, for the cells' loose boxes.
     reach: Reach,
     /// Slots of the oversized objects.
@@ -82,7 +85,6 @@ impl<T, S: Store> CellGrid<T, S> {
             store,
             items: Arena::new(),
             spheres: Vec::new(),
-            handles: Vec::new(),
             reach: Reach::default(),
             oversized: Vec::new(),
             refs: 0,
@@ -116,12 +118,17 @@ impl<T, S: Store> CellGrid<T, S> {
     /// slots (checked by `validate`), so failure is a bug.
     #[inline]
     fn resolve(&self, slot: u32) -> (Handle, &T) {
-        let h = self.handles[slot as usize];
-        let item = self
+        let (h, item) = self
             .items
-            .get(h)
+            .get_by_index(slot)
             .expect("grid reference to a dead slot: invariant broken");
         (h, &item.value)
+    }
+
+    /// The handle of a referenced slot.
+    #[inline]
+    fn handle(&self, slot: u32) -> Handle {
+        self.resolve(slot).0
     }
 
     /// Stores an object. O(cells covered × references per cell).
@@ -133,11 +140,9 @@ impl<T, S: Store> CellGrid<T, S> {
         let place = self.place(slot, None, &sphere);
         let h2 = self.items.insert(Item { place, value })?;
         debug_assert_eq!(h, h2);
-        if self.handles.len() <= slot as usize {
-            self.handles.resize(slot as usize + 1, h);
+        if self.spheres.len() <= slot as usize {
             self.spheres.resize(slot as usize + 1, sphere);
         }
-        self.handles[slot as usize] = h;
         self.spheres[slot as usize] = sphere;
         Ok(h)
     }
@@ -187,7 +192,6 @@ impl<T, S: Store> CellGrid<T, S> {
         self.store.clear();
         self.items.clear();
         self.spheres = Vec::new();
-        self.handles = Vec::new();
         self.reach = Reach::default();
         self.oversized = Vec::new();
         self.refs = 0;
@@ -205,7 +209,6 @@ impl<T, S: Store> CellGrid<T, S> {
         std::mem::size_of::<Self>()
             + self.store.heap_bytes()
             + self.items.heap_bytes()
-            + self.handles.capacity() * std::mem::size_of::<Handle>()
             + self.spheres.capacity() * std::mem::size_of::<Sphere>()
             + self.oversized.capacity() * 4
     }

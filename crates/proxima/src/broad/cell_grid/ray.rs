@@ -366,13 +366,13 @@ impl<T, S: Store> CellGrid<T, S> {
         let mut best: Option<RayHit> = None;
         for &slot in &self.oversized {
             if let Some(t) = overlap::ray_sphere(ray, &self.spheres[slot as usize]) {
-                RayHit::offer(&mut best, t, self.handles[slot as usize]);
+                RayHit::offer(&mut best, t, self.handle(slot));
             }
         }
         let _ = self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
                 if let Some(t) = overlap::ray_sphere(ray, &self.spheres[e.slot as usize]) {
-                    RayHit::offer(&mut best, t, self.handles[e.slot as usize]);
+                    RayHit::offer(&mut best, t, self.handle(e.slot));
                 }
                 ControlFlow::Continue(())
             }

@@ -11,6 +11,16 @@ use std::ops::ControlFlow;
 /// The entries of one cell, as the visits see them.
 pub(crate) type Entries<'a, P> = &'a [CellEntry<P>];
 
+/// Where a box of keys lies among a store's top-level blocks.
+pub(crate) enum Within<B> {
+    /// Inside this one block.
+    One(B),
+    /// Inside one block that holds no occupied cell.
+    Empty,
+    /// Across several blocks.
+    Many,
+}
+
 /// Cell addressing and storage behind a [`CellGrid`](super::CellGrid).
 ///
 /// The visits report only non-empty cells, each once, with its key; their
@@ -74,6 +84,19 @@ pub(crate) trait Store: Clone + Debug {
         kb: &KeyBox,
         f: impl FnMut(KeyBox, Self::Block) -> ControlFlow<()>,
     ) -> ControlFlow<()>;
+
+    /// Where `region` lies among the top-level blocks.
+    fn within(&self, region: &KeyBox) -> Within<Self::Block>;
+
+    /// Splits a `region` that spans several blocks in two along a block
+    /// boundary, across the axis along which it spans the most blocks.
+    fn split(&self, region: &KeyBox) -> (KeyBox, KeyBox);
+
+    /// True if descending over `kb` (clipped to the occupied box) from the
+    /// whole box down to blocks costs O(occupied cells): the blocks of `kb`
+    /// are not many more than the occupied ones. Else a visit cuts `kb` with
+    /// [`Store::blocks_in`].
+    fn descent_is_bounded(&self, kb: &KeyBox) -> bool;
 
     /// False if no cell of `region` (inside `block`) is occupied; true when
     /// unknown.

@@ -7,7 +7,7 @@ use crate::{Error, Result};
 
 impl<T, S: Store> CellGrid<T, S> {
     /// Checks, in O(references + cells), naming the front end `name` in errors:
-    /// - the arena, and the slot → handle table for every live object;
+    /// - the arena, and a sphere for every live object;
     /// - every object's place is the one its sphere gives (the cells of its key
     ///   box, or the oversized list at the position it stores);
     /// - the store's own bookkeeping;
@@ -27,9 +27,6 @@ impl<T, S: Store> CellGrid<T, S> {
         let mut oversized = 0usize;
         for (h, item) in self.items.iter() {
             let slot = h.index();
-            if self.handles.get(slot as usize) != Some(&h) {
-                return fail(format!("slot {slot} does not map back to its handle"));
-            }
             let Some(sphere) = self.spheres.get(slot as usize) else {
                 return fail(format!("no sphere for slot {slot}"));
             };
@@ -65,7 +62,7 @@ impl<T, S: Store> CellGrid<T, S> {
         let mut total = 0usize;
         // The cell in which each slot was last seen: a repeat within a cell is a
         // duplicate (cells are visited one at a time).
-        let mut last_cell = vec![None; self.handles.len()];
+        let mut last_cell = vec![None; self.spheres.len()];
         let mut bad = None;
         let _ = self.store.cells(|key, es| {
             if !occupied.contains(key) {
@@ -73,10 +70,7 @@ impl<T, S: Store> CellGrid<T, S> {
                 return std::ops::ControlFlow::Break(());
             }
             for e in es {
-                let item = self
-                    .handles
-                    .get(e.slot as usize)
-                    .and_then(|&h| self.items.get(h).ok());
+                let item = self.items.get_by_index(e.slot).map(|(_, item)| item);
                 let problem = match item {
                     None => Some("an unknown or dead"),
                     Some(item) => match item.place {

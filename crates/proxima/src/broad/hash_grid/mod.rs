@@ -64,11 +64,22 @@ impl HashGridConfig {
 /// **Unbounded queries.** A query's key box is clipped to the box of occupied
 /// cells, and its blocks are looked up only if they are no more than the
 /// occupied blocks; otherwise the occupied blocks are scanned. Large key boxes
-/// and frustums (which have no bounding box) descend from the blocks, culling
-/// and accepting whole blocks and halves of blocks by the boxes of the objects
-/// they report. Rays walk the cells along the ray within the occupied box, or
-/// scan when that walk would be longer. So no query does more work than there
-/// are occupied cells.
+/// and frustums (which have no bounding box) descend from the whole box to
+/// its blocks and halves of blocks, culling and accepting each by the boxes of
+/// the objects it reports (clusters far apart are cut into their occupied
+/// blocks instead). Rays walk the cells along the ray within the occupied box,
+/// or scan when that walk would be longer. So no query does more work than
+/// there are occupied cells.
+///
+/// **Not the fastest for many small range queries on a static set.** Each
+/// object is referenced from about 4–8 cells, each cell's list is its own
+/// allocation, and a query visits 8–27 cells: memory traffic, not arithmetic,
+/// bounds it. On W4 (100 000 static spheres in a cube, `proxima-bench w4`, a
+/// shared machine) its small sphere and box queries took 1.8–2.5× the time of
+/// rstar's R-tree, while its rays (0.9×) and frusta (1.7–1.9×) kept within
+/// 2×. For that use, [`UniformGrid3d`](super::UniformGrid3d) (about rstar's
+/// speed there) or a bulk-loaded tree suits better; the hash grid is for
+/// scenes without bounds that move every frame.
 ///
 /// **Once-only reporting with `&self`**: as in
 /// [`UniformGrid2d`](crate::broad::UniformGrid2d), an object is reported only from

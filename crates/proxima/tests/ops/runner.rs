@@ -163,7 +163,7 @@ impl Named {
     fn ray_first(&self, r: &Ray) -> Result<Option<(u32, f32)>> {
         Ok(self
             .index
-            .ray_first(r)?
+            .ray_first(r, None)?
             .map(|h| (*self.index.get(h.handle).unwrap().1, h.t)))
     }
     fn pairs(&self) -> Vec<(u32, u32)> {

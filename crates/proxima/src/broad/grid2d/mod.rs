@@ -16,8 +16,8 @@ mod validate;
 
 use crate::arena::Arena;
 use crate::broad::cell_list::{CellList, Reach};
-use crate::broad::walk::{walk_methods, Walk};
-use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
+use crate::broad::walk::{self, walk_methods, Walk};
+use crate::broad::{Filter, IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Handle, Result};
 use cells::{CellRect, Geometry};
@@ -60,6 +60,8 @@ impl Grid2dConfig {
 #[derive(Clone, Debug)]
 struct Item<T> {
     rect: CellRect,
+    /// Read with the payload when a pair is reported.
+    filter: Filter,
     value: T,
 }
 
@@ -183,6 +185,12 @@ impl<T> UniformGrid2d<T> {
         self.refs
     }
 
+    /// The filter of the live object at `slot`.
+    #[inline]
+    fn slot_filter(&self, slot: u32) -> Filter {
+        self.filter_of(self.handles[slot as usize])
+    }
+
     /// The handle and payload of a referenced slot. References always name live
     /// slots (checked by `validate`), so failure is a bug.
     #[inline]
@@ -212,10 +220,14 @@ impl<T> UniformGrid2d<T> {
 }
 
 impl<T: Send + Sync> SpatialIndex<T> for UniformGrid2d<T> {
-    fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
         sphere.validate()?;
         let rect = self.geom.sphere_rect(&sphere);
-        let h = self.items.insert(Item { rect, value })?;
+        let h = self.items.insert(Item {
+            rect,
+            filter,
+            value,
+        })?;
         let slot = h.index() as usize;
         if self.handles.len() <= slot {
             self.handles.resize(slot + 1, h);
@@ -254,6 +266,15 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid2d<T> {
     fn get(&self, handle: Handle) -> Result<(Sphere, &T)> {
         let item = self.items.get(handle)?;
         Ok((self.spheres[handle.index() as usize], &item.value))
+    }
+
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        self.items.get(handle).map(|i| i.filter)
+    }
+
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        self.items.get_mut(handle)?.filter = filter;
+        Ok(())
     }
 
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
@@ -324,8 +345,21 @@ impl<T> Walk<T> for UniformGrid2d<T> {
         self.pair_cells(f)
     }
 
-    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
-        self.ray_first_cells(ray)
+    fn filter_of(&self, h: Handle) -> Filter {
+        self.items.get(h).expect("a live handle").filter
+    }
+
+    fn object_count(&self) -> usize {
+        self.items.len()
+    }
+
+    /// The cell walk along the ray; with a query filter, the filtered scan of
+    /// every hit (the cell walk does not filter yet).
+    fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
+        match filter {
+            None => self.ray_first_cells(ray),
+            Some(_) => walk::scan_first_hit(self, ray, filter),
+        }
     }
 }
 

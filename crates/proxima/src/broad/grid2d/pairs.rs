@@ -45,6 +45,9 @@ impl<T> UniformGrid2d<T> {
                         && ea.lo[0].max(eb.lo[0]) == x
                         && ea.lo[1].max(eb.lo[1]) == y
                         && overlap::sphere_sphere(sa, sb)
+                        && self
+                            .slot_filter(ea.slot)
+                            .interacts(self.slot_filter(eb.slot))
                     {
                         let (ha, va) = self.resolve(ea.slot);
                         let (hb, vb) = self.resolve(eb.slot);

@@ -15,8 +15,8 @@ mod validate;
 
 use crate::arena::Arena;
 use crate::broad::cell_list::{CellList, Reach};
-use crate::broad::walk::{walk_methods, Walk};
-use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
+use crate::broad::walk::{self, walk_methods, Walk};
+use crate::broad::{Filter, IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Handle, Result};
 use keys::{Key, KeyBox, Keys};
@@ -63,6 +63,8 @@ enum Place {
 #[derive(Clone, Debug)]
 struct Item<T> {
     place: Place,
+    /// Read with the payload when a pair is reported.
+    filter: Filter,
     value: T,
 }
 
@@ -212,6 +214,12 @@ impl<T> HashGrid<T> {
         (kb.volume() <= MAX_CELLS_PER_OBJECT).then_some(kb)
     }
 
+    /// The filter of the live object at `slot`.
+    #[inline]
+    fn slot_filter(&self, slot: u32) -> Filter {
+        self.filter_of(self.handles[slot as usize])
+    }
+
     /// The handle and payload of a referenced slot (references name live slots:
     /// checked by `validate`, so failure is a bug).
     #[inline]
@@ -240,7 +248,7 @@ impl<T> HashGrid<T> {
 }
 
 impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
-    fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
         sphere.validate()?;
         self.items.check_room()?;
         let cells = self.cells_of(&sphere);
@@ -257,7 +265,11 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
                 Place::Oversized(self.oversized.len() as u32 - 1)
             }
         };
-        let h2 = self.items.insert(Item { place, value })?;
+        let h2 = self.items.insert(Item {
+            place,
+            filter,
+            value,
+        })?;
         debug_assert_eq!(h, h2);
         if self.handles.len() <= slot as usize {
             self.handles.resize(slot as usize + 1, h);
@@ -316,6 +328,15 @@ impl<T: Send + Sync> SpatialIndex<T> for HashGrid<T> {
     fn get(&self, handle: Handle) -> Result<(Sphere, &T)> {
         let item = self.items.get(handle)?;
         Ok((self.spheres[handle.index() as usize], &item.value))
+    }
+
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        self.items.get(handle).map(|i| i.filter)
+    }
+
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        self.items.get_mut(handle)?.filter = filter;
+        Ok(())
     }
 
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
@@ -399,8 +420,21 @@ impl<T> Walk<T> for HashGrid<T> {
         self.pair_cells(f)
     }
 
-    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
-        self.ray_first_cells(ray)
+    fn filter_of(&self, h: Handle) -> Filter {
+        self.items.get(h).expect("a live handle").filter
+    }
+
+    fn object_count(&self) -> usize {
+        self.items.len()
+    }
+
+    /// The cell walk along the ray; with a query filter, the filtered scan of
+    /// every hit (the cell walk does not filter yet).
+    fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
+        match filter {
+            None => self.ray_first_cells(ray),
+            Some(_) => walk::scan_first_hit(self, ray, filter),
+        }
     }
 }
 

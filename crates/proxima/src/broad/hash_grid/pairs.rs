@@ -2,6 +2,7 @@
 
 use super::keys::KeyBox;
 use super::HashGrid;
+use crate::broad::walk::Walk;
 use crate::geom::{overlap, Sphere};
 use crate::Handle;
 use std::ops::ControlFlow;
@@ -43,6 +44,9 @@ impl<T> HashGrid<T> {
                         && ea.lo[1].max(eb.lo[1]) == key[1]
                         && ea.lo[2].max(eb.lo[2]) == key[2]
                         && overlap::sphere_sphere(sa, sb)
+                        && self
+                            .slot_filter(ea.slot)
+                            .interacts(self.slot_filter(eb.slot))
                     {
                         let (ha, va) = self.resolve(ea.slot);
                         let (hb, vb) = self.resolve(eb.slot);
@@ -54,14 +58,23 @@ impl<T> HashGrid<T> {
         for (i, &a) in self.oversized.iter().enumerate() {
             let (ha, va) = self.resolve(a);
             let sa = &self.spheres[a as usize];
+            let fa = self.slot_filter(a);
             for &b in &self.oversized[i + 1..] {
-                if overlap::sphere_sphere(sa, &self.spheres[b as usize]) {
+                if fa.interacts(self.slot_filter(b))
+                    && overlap::sphere_sphere(sa, &self.spheres[b as usize])
+                {
                     let (hb, vb) = self.resolve(b);
                     f(ha, va, hb, vb)?;
                 }
             }
             let kb: KeyBox = self.keys.sphere_box(sa);
-            self.visit_cells(sa, kb, &mut |hb, _, vb| f(ha, va, hb, vb))?;
+            self.visit_cells(sa, kb, &mut |hb, _, vb| {
+                if fa.interacts(self.filter_of(hb)) {
+                    f(ha, va, hb, vb)
+                } else {
+                    ControlFlow::Continue(())
+                }
+            })?;
         }
         ControlFlow::Continue(())
     }

@@ -30,7 +30,7 @@ pub use visit::KdNodeView;
 use crate::arena::{Arena, Pool};
 
 use crate::broad::walk::{walk_methods, Walk};
-use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
+use crate::broad::{Filter, IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Handle, Result};
 use node::{Node, NIL};
@@ -275,6 +275,12 @@ impl<T> LooseKdTree<T> {
         }
     }
 
+    /// Position in the object array of the object at `loc`.
+    #[inline]
+    fn position(&self, loc: Loc) -> usize {
+        (self.nodes[loc.node].start + loc.pos) as usize
+    }
+
     /// Forgets the bounds of removed objects once nothing is stored.
     fn reset_span_if_empty(&mut self) {
         if self.items.is_empty() {
@@ -286,7 +292,7 @@ impl<T> LooseKdTree<T> {
 
 impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     /// `Push` [sources: kd-insert]: O(depth), creating the missing nodes on the way.
-    fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
         sphere.validate()?;
         // Before `cover` and `descend` change the tree: a full index stays as it was.
         self.items.check_room()?;
@@ -294,7 +300,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         let root = self.ensure_root();
         let node = self.descend(root, &sphere);
         let handle = self.items.insert(Loc { node, pos: 0 })?;
-        self.put(node, sphere, handle, value);
+        self.put(node, sphere, handle, filter, value);
         self.maybe_compact();
         Ok(handle)
     }
@@ -302,7 +308,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     /// `Pop` [sources: kd-remove]: O(1) swap-remove from the node, then frees emptied nodes upwards.
     fn remove(&mut self, handle: Handle) -> Result<T> {
         let loc = *self.items.get(handle)?;
-        let (_, _, value) = self.take(loc);
+        let (_, _, _, value) = self.take(loc);
         self.prune_up(loc.node);
         self.items.remove(handle)?;
         self.reset_span_if_empty();
@@ -330,8 +336,19 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
         let loc = *self.items.get(handle)?;
         let p = (self.nodes[loc.node].start + loc.pos) as usize;
-        let (_, v) = self.store.entry[p].as_mut().expect("live position");
+        let (_, _, v) = self.store.entry[p].as_mut().expect("live position");
         Ok(v)
+    }
+
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        let loc = self.items.get(handle)?;
+        Ok(self.store.full(self.position(*loc)).1)
+    }
+
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        let p = self.position(*self.items.get(handle)?);
+        self.store.entry[p].as_mut().expect("live position").1 = filter;
+        Ok(())
     }
 
     fn len(&self) -> usize {
@@ -397,9 +414,18 @@ impl<T> Walk<T> for LooseKdTree<T> {
         self.pairs_impl(f)
     }
 
+    fn filter_of(&self, h: Handle) -> Filter {
+        let loc = self.items.get(h).expect("a live handle");
+        self.store.full(self.position(*loc)).1
+    }
+
+    fn object_count(&self) -> usize {
+        self.items.len()
+    }
+
     /// Front-to-back: nearer child first, subtrees whose region the ray enters
     /// after the best hit so far are skipped.
-    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
-        self.ray_first_impl(ray)
+    fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
+        self.ray_first_impl(ray, filter)
     }
 }

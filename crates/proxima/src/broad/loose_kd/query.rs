@@ -4,7 +4,7 @@
 use super::node::{FixedStack, NIL};
 use super::store::CHUNK;
 use super::LooseKdTree;
-use crate::broad::{RayHit, Selection};
+use crate::broad::{Filter, RayHit, Selection};
 use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
 use crate::Handle;
 use glam::Vec3;
@@ -223,7 +223,9 @@ impl<T> LooseKdTree<T> {
     /// `overlap::ray_sphere` on the unshortened ray, as in the default scan, so the
     /// answer is identical: a pruned box has `ray_aabb`'s entry bound above the
     /// best `t`, and that bound is at most the `t` of every sphere inside.
-    pub(super) fn ray_first_impl(&self, ray: &Ray) -> Option<RayHit> {
+    /// Objects whose filter does not interact with `filter` are skipped (a
+    /// check at the candidate, not yet a pruning of subtrees).
+    pub(super) fn ray_first_impl(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
         if self.root == NIL {
             return None;
         }
@@ -242,7 +244,10 @@ impl<T> LooseKdTree<T> {
                 // The full ray: its `t` is what brute force reports (`ray_sphere`
                 // clamps into `[.., max_t]`); the shortened `r` only prunes boxes.
                 if let Some(t) = overlap::ray_sphere(ray, s).filter(|&t| t <= r.max_t) {
-                    let h = self.store.at(q).0;
+                    let (h, of, _) = self.store.full(q);
+                    if filter.is_some_and(|f| !f.interacts(of)) {
+                        continue;
+                    }
                     if RayHit::offer(&mut best, t, h) {
                         r.max_t = t;
                     }

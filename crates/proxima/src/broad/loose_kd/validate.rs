@@ -112,7 +112,7 @@ impl<T> LooseKdTree<T> {
                 }
             }
             for (pos, p) in node.range().enumerate() {
-                let Some((handle, _)) = &self.store.entry[p] else {
+                let Some((handle, _, _)) = &self.store.entry[p] else {
                     return fail(format!("node {n}: live position {p} empty"));
                 };
                 match self.items.get(*handle) {

@@ -25,7 +25,7 @@ pub use stats::OctreeStats;
 use crate::arena::{Arena, Pool};
 
 use crate::broad::walk::{walk_methods, Walk};
-use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
+use crate::broad::{Filter, IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Handle, Result};
 use glam::Vec3;
@@ -253,9 +253,9 @@ impl<T> LinearOctree<T> {
 }
 
 impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
-    fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
         sphere.validate()?;
-        self.insert_valid(sphere, value)
+        self.insert_valid(sphere, filter, value)
     }
 
     fn remove(&mut self, handle: Handle) -> Result<T> {
@@ -275,6 +275,15 @@ impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
 
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
         self.objects.get_mut(handle).map(|o| &mut o.value)
+    }
+
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        self.objects.get(handle).map(|o| o.filter)
+    }
+
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        self.objects.get_mut(handle)?.filter = filter;
+        Ok(())
     }
 
     fn len(&self) -> usize {
@@ -322,9 +331,17 @@ impl<T> Walk<T> for LinearOctree<T> {
         self.pairs_tree(&mut f)
     }
 
+    fn filter_of(&self, h: Handle) -> Filter {
+        self.obj(h).filter
+    }
+
+    fn object_count(&self) -> usize {
+        self.objects.len()
+    }
+
     /// Front-to-back: children in order of entry along the ray, subtrees entered
     /// after the best hit so far skipped.
-    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
-        self.ray_first_tree(ray)
+    fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
+        self.ray_first_tree(ray, filter)
     }
 }

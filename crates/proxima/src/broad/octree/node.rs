@@ -4,6 +4,7 @@
 use super::code::{cell_box_of, point_key, LocationCode, MAX_DEPTH};
 use super::LinearOctree;
 use crate::arena::{Arena, Pool};
+use crate::broad::Filter;
 use crate::geom::{Aabb, Sphere};
 use crate::Handle;
 use glam::Vec3;
@@ -33,6 +34,9 @@ pub(super) struct Obj<T> {
     /// Leaf node index and position in its item list.
     pub leaf: u32,
     pub slot: u32,
+    /// The collision filter: read with the payload when a pair is reported,
+    /// never by the walks themselves.
+    pub filter: Filter,
     pub value: T,
 }
 

@@ -4,7 +4,7 @@
 use super::node::NONE;
 use super::query::child_coords;
 use super::LinearOctree;
-use crate::broad::RayHit;
+use crate::broad::{Filter, RayHit};
 use crate::geom::{overlap, Ray};
 
 /// A subtree is skipped only when its box entry `t0` exceeds the best hit by more
@@ -16,18 +16,30 @@ impl<T> LinearOctree<T> {
     /// The hit with the smallest `(t, handle)`; children are visited in order of
     /// their loose boxes' entry parameter. No allocation (≤ 8 children sorted on
     /// the stack per level).
-    pub(super) fn ray_first_tree(&self, ray: &Ray) -> Option<RayHit> {
+    /// Objects whose filter does not interact with `filter` are skipped at
+    /// the candidate.
+    pub(super) fn ray_first_tree(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
         let mut best = None;
         if !self.objects.is_empty() {
             let n = &self.nodes[self.root];
             if let Some((t0, _)) = overlap::ray_aabb(ray, &self.loose_of([0; 3], 0, n.max_extent)) {
-                self.ray_node(self.root, [0; 3], 0, t0, ray, &mut best);
+                self.ray_node(self.root, [0; 3], 0, t0, ray, filter, &mut best);
             }
         }
         best
     }
 
-    fn ray_node(&self, i: u32, c: [u32; 3], d: u32, t0: f32, ray: &Ray, best: &mut Option<RayHit>) {
+    #[allow(clippy::too_many_arguments)]
+    fn ray_node(
+        &self,
+        i: u32,
+        c: [u32; 3],
+        d: u32,
+        t0: f32,
+        ray: &Ray,
+        filter: Option<Filter>,
+        best: &mut Option<RayHit>,
+    ) {
         if let Some(b) = best {
             if t0 > b.t + PRUNE_MARGIN * (b.t.abs() + 1.0) {
                 return;
@@ -37,7 +49,9 @@ impl<T> LinearOctree<T> {
         if n.leaf {
             for it in &n.items {
                 if let Some(t) = overlap::ray_sphere(ray, &it.sphere) {
-                    RayHit::offer(best, t, it.handle);
+                    if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
+                        RayHit::offer(best, t, it.handle);
+                    }
                 }
             }
             return;
@@ -57,7 +71,7 @@ impl<T> LinearOctree<T> {
         }
         order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         for &(ct0, ch, cc) in &order[..m] {
-            self.ray_node(ch, cc, d + 1, ct0, ray, best);
+            self.ray_node(ch, cc, d + 1, ct0, ray, filter, best);
         }
     }
 }

@@ -3,7 +3,7 @@
 //! counters of [sources: bvh-cost].
 
 use super::mesh::Mesh;
-use super::traverse::{traverse, Lazy, Local, Precomputed};
+use super::traverse::{traverse, ExactLeaves, Lazy, Local, Precomputed};
 use super::tri_cache::{QueryCache, TriangleCache};
 use crate::narrow::bv::{slack_for, BoundingVolume};
 use crate::narrow::PreparedTriangle;
@@ -257,6 +257,18 @@ impl<BV: BoundingVolume> Collider<BV> {
             false
         };
         let moved = |v: u32| pose.transform_point3(va[v as usize]);
+        // The descent, ordered deepest overlap first for a first contact.
+        macro_rules! go {
+            ($src:expr, $corner:expr) => {
+                if first {
+                    traverse::<BV, true>(ta, $src, tb, stack, &mut c.nv, |x, y| leaf($corner, x, y))
+                } else {
+                    traverse::<BV, false>(ta, $src, tb, stack, &mut c.nv, |x, y| {
+                        leaf($corner, x, y)
+                    })
+                }
+            };
+        }
         if BV::AXIS_ALIGNED && rotated {
             let update = match *rotation {
                 RotationUpdate::Auto => RotationUpdate::Conservative,
@@ -269,23 +281,24 @@ impl<BV: BoundingVolume> Collider<BV> {
                     c.nu = ta.world_volumes(world_vertices, slack, world);
                     let wv: &[Vec3] = world_vertices;
                     let corner = |v: u32| wv[v as usize];
-                    traverse(ta, &mut Precomputed(world), tb, stack, &mut c.nv, |x, y| {
-                        leaf(&corner, x, y)
-                    });
+                    go!(&mut Precomputed(world), &corner);
                 }
                 _ => {
                     cache.begin(ta.nodes.len(), ta.nodes[0].bv);
-                    let mut src = Lazy {
-                        nodes: &ta.nodes,
-                        pose: *pose,
-                        slack,
-                        cache,
-                        updates: 0,
+                    let mut src = ExactLeaves {
+                        lazy: Lazy {
+                            nodes: &ta.nodes,
+                            pose: *pose,
+                            slack,
+                            cache,
+                            updates: 0,
+                        },
+                        tris: &ta.tris,
+                        vertices: va,
+                        sizes: &ta.subtree,
                     };
-                    traverse(ta, &mut src, tb, stack, &mut c.nv, |x, y| {
-                        leaf(&moved, x, y)
-                    });
-                    c.nu = src.updates;
+                    go!(&mut src, &moved);
+                    c.nu = src.lazy.updates;
                 }
             }
         } else {
@@ -293,9 +306,7 @@ impl<BV: BoundingVolume> Collider<BV> {
                 nodes: &ta.nodes,
                 motion: BV::motion(pose, slack),
             };
-            traverse(ta, &mut src, tb, stack, &mut c.nv, |x, y| {
-                leaf(&moved, x, y)
-            });
+            go!(&mut src, &moved);
         }
         c.np = np;
         Ok(c)

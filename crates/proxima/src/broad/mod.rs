@@ -36,7 +36,7 @@ mod any;
 mod brute;
 mod cell_list;
 mod ext;
-mod filter;
+pub(crate) mod filter;
 mod grid2d;
 mod grid3d;
 mod hash_grid;

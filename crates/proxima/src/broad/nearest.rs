@@ -128,6 +128,87 @@ pub(crate) fn finish(out: &mut Vec<Neighbor>, k: usize) {
     out.sort_unstable_by(Neighbor::order);
 }
 
+/// The `k` best candidates seen so far, kept as a max-heap (worst first, in
+/// [`Neighbor::order`]) inside the caller's output buffer: the bounded heap of
+/// the best-first and branch-and-bound searches. No allocation once the buffer
+/// holds `k` entries.
+pub(crate) struct KBest<'a> {
+    heap: &'a mut Vec<Neighbor>,
+    k: usize,
+    limit: f32,
+}
+
+impl<'a> KBest<'a> {
+    /// An empty heap in `out` (cleared) for the `k` best within `limit`.
+    pub(crate) fn new(out: &'a mut Vec<Neighbor>, k: usize, limit: f32) -> Self {
+        out.clear();
+        KBest {
+            heap: out,
+            k,
+            limit,
+        }
+    }
+
+    /// The largest distance a candidate may have and still enter: the limit
+    /// until `k` are held, then the worst held distance (a candidate at exactly
+    /// that distance may still enter with a smaller handle, so searches prune
+    /// only what lies strictly beyond it).
+    #[inline]
+    pub(crate) fn bound(&self) -> f32 {
+        if self.heap.len() < self.k {
+            self.limit
+        } else {
+            self.heap[0].distance
+        }
+    }
+
+    /// Offers a candidate: kept if fewer than `k` are held or it precedes the
+    /// worst held one. O(log k).
+    #[inline]
+    pub(crate) fn offer(&mut self, n: Neighbor) {
+        if n.distance > self.limit || self.k == 0 {
+            return;
+        }
+        let h = &mut *self.heap;
+        if h.len() < self.k {
+            h.push(n);
+            let mut i = h.len() - 1;
+            while i > 0 {
+                let p = (i - 1) / 2;
+                if Neighbor::order(&h[p], &h[i]).is_lt() {
+                    h.swap(p, i);
+                    i = p;
+                } else {
+                    break;
+                }
+            }
+        } else if Neighbor::order(&n, &h[0]).is_lt() {
+            h[0] = n;
+            let mut i = 0;
+            loop {
+                let (l, r) = (2 * i + 1, 2 * i + 2);
+                let mut m = i;
+                if l < h.len() && Neighbor::order(&h[m], &h[l]).is_lt() {
+                    m = l;
+                }
+                if r < h.len() && Neighbor::order(&h[m], &h[r]).is_lt() {
+                    m = r;
+                }
+                if m == i {
+                    break;
+                }
+                h.swap(i, m);
+                i = m;
+            }
+        }
+    }
+
+    /// Puts the held candidates in answer order. O(k log k).
+    pub(crate) fn finish(self) {
+        self.heap.sort_unstable_by(Neighbor::order);
+    }
+}
+
 /// Radius of the first sphere query: small, so that a dense neighbourhood
 /// costs few candidates; it grows geometrically from there.
 const FIRST_RADIUS: f32 = 1.0 / 1024.0;

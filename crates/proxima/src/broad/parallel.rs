@@ -334,6 +334,58 @@ mod tests {
         batches(&grid);
     }
 
+    /// The batch k-nearest search gives, per query, exactly the sequential
+    /// answer (filtered or not), in the flat layout, on a 2-thread pool, for
+    /// every index kind; a bad query fails the batch.
+    #[test]
+    fn par_nearest_matches_sequential() {
+        use crate::broad::{Filter, IndexKind, Metric, SceneHint};
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let mut next = rng(5);
+        let mut qs: Vec<Nearest> = (0..300)
+            .map(|i| {
+                let p = Vec3::new(next(), next(), next()) * 70.0 - Vec3::splat(5.0);
+                let q = Nearest::new(p, [0, 1, 8, 64, 5000][i % 5]);
+                match i % 3 {
+                    0 => q,
+                    1 => q.within(3.0),
+                    _ => q.metric(Metric::Center),
+                }
+            })
+            .collect();
+        qs.push(Nearest::new(Vec3::splat(1e7), 3));
+        let hint = SceneHint::new(Aabb::new(Vec3::ZERO, Vec3::splat(60.0)), 2.2);
+        for kind in IndexKind::ALL {
+            let mut index = kind.build::<u32>(&hint).unwrap();
+            fill(&mut index);
+            let mut hs = Vec::new();
+            index.for_each(&mut |h, _, _| hs.push(h));
+            for (i, h) in hs.iter().enumerate() {
+                index
+                    .set_filter(*h, Filter::new(1 << (i % 3), 0b011))
+                    .unwrap();
+            }
+            for filter in [None, Some(Filter::new(0b100, 0b001))] {
+                let batch = pool.install(|| par_nearest(&index, &qs, filter)).unwrap();
+                assert_eq!(batch.len(), qs.len());
+                let mut total = 0;
+                for (i, q) in qs.iter().enumerate() {
+                    let mut one = Vec::new();
+                    index.nearest_into(q, filter, &mut one).unwrap();
+                    assert_eq!(batch.get(i), &one[..], "{kind:?} query {i}");
+                    total += one.len();
+                }
+                assert!(total > qs.len(), "{kind:?}: the batch must find things");
+            }
+            let mut bad = qs.clone();
+            bad[7].point.x = f32::NAN;
+            assert!(par_nearest(&index, &bad, None).is_err());
+        }
+    }
+
     #[test]
     fn a_bad_query_fails_the_batch_before_any_work() {
         let mut kd = LooseKdTree::with_config(LooseKdConfig {

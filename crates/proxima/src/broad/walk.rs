@@ -13,7 +13,7 @@
 
 use super::nearest::{self, Nearest, Neighbor};
 use super::{Filter, Query, RayHit, Selection};
-use crate::geom::{overlap, Ray, Sphere, SphereSweep};
+use crate::geom::{overlap, Aabb, Ray, Sphere, SphereSweep};
 use crate::{Handle, Result};
 use std::ops::ControlFlow;
 
@@ -69,24 +69,17 @@ pub(crate) trait Walk<T> {
     /// every hit; indices with a hierarchy override it with a front-to-back
     /// search.
     fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
-        scan_first_hit(self, ray, filter)
+        scan_first(self, ray, filter)
     }
 
     /// The object the sweep touches first: smallest time of impact
     /// ([`overlap::sweep_sphere`]), ties by the smaller handle, among the
     /// objects `filter` admits; without validating the sweep. The default scans
     /// every touched object (the index's walk for [`Query::Sweep`]); indices
-    /// with a hierarchy may search front to back, pruning by
+    /// with a hierarchy search front to back, pruning by
     /// [`overlap::sweep_aabb`]'s entry bound.
     fn first_sweep_hit(&self, sweep: &SphereSweep, filter: Option<Filter>) -> Option<RayHit> {
-        let mut best: Option<RayHit> = None;
-        let _ = self.walk_filtered(sweep, filter, |h, s, _| {
-            if let Some(t) = overlap::sweep_sphere(sweep, s) {
-                RayHit::offer(&mut best, t, h);
-            }
-            ControlFlow::Continue(())
-        });
-        best
+        scan_first(self, sweep, filter)
     }
 
     /// The answer of a k-nearest query into `out` (cleared first), nearest
@@ -98,17 +91,54 @@ pub(crate) trait Walk<T> {
     }
 }
 
-/// The first ray hit by a scan of every hit (the default of
-/// [`Walk::first_hit`], also the fallback of overrides that do not handle a
-/// query filter).
-pub(crate) fn scan_first_hit<T, I: Walk<T> + ?Sized>(
+/// A ray or a sphere sweep, as the first-hit searches see it: a selection
+/// with a parameter of first contact. Written once here so that every index
+/// answers `ray_first` and `sweep_first` with one search each.
+pub(crate) trait Cast: Selection {
+    /// The parameter at which the cast first touches the closed sphere `s`,
+    /// or `None` ([`overlap::ray_sphere`], [`overlap::sweep_sphere`]).
+    fn contact(&self, s: &Sphere) -> Option<f32>;
+    /// A lower bound on [`Cast::contact`] of every sphere inside `b`, or `None`
+    /// when the cast touches nothing inside it ([`overlap::ray_aabb`],
+    /// [`overlap::sweep_aabb`]); monotone in the box, so front-to-back searches
+    /// may skip a box entered after the best contact so far.
+    fn enter(&self, b: &Aabb) -> Option<f32>;
+}
+
+impl Cast for Ray {
+    #[inline]
+    fn contact(&self, s: &Sphere) -> Option<f32> {
+        overlap::ray_sphere(self, s)
+    }
+    #[inline]
+    fn enter(&self, b: &Aabb) -> Option<f32> {
+        overlap::ray_aabb(self, b).map(|(t0, _)| t0)
+    }
+}
+
+impl Cast for SphereSweep {
+    #[inline]
+    fn contact(&self, s: &Sphere) -> Option<f32> {
+        overlap::sweep_sphere(self, s)
+    }
+    #[inline]
+    fn enter(&self, b: &Aabb) -> Option<f32> {
+        overlap::sweep_aabb(self, b).map(|(t0, _)| t0)
+    }
+}
+
+/// The first contact of a ray or sweep by a scan of everything the index's
+/// walk selects (the default of [`Walk::first_hit`] and
+/// [`Walk::first_sweep_hit`], also the fallback of overrides that do not
+/// handle a query filter).
+pub(crate) fn scan_first<T, I: Walk<T> + ?Sized, C: Cast>(
     index: &I,
-    ray: &Ray,
+    cast: &C,
     filter: Option<Filter>,
 ) -> Option<RayHit> {
     let mut best: Option<RayHit> = None;
-    let _ = index.walk_filtered(ray, filter, |h, s, _| {
-        if let Some(t) = overlap::ray_sphere(ray, s) {
+    let _ = index.walk_filtered(cast, filter, |h, s, _| {
+        if let Some(t) = cast.contact(s) {
             RayHit::offer(&mut best, t, h);
         }
         ControlFlow::Continue(())

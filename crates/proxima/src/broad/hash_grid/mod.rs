@@ -433,7 +433,7 @@ impl<T> Walk<T> for HashGrid<T> {
     fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
         match filter {
             None => self.ray_first_cells(ray),
-            Some(_) => walk::scan_first_hit(self, ray, filter),
+            Some(_) => walk::scan_first(self, ray, filter),
         }
     }
 }

@@ -105,10 +105,25 @@ impl<T> LooseKdTree<T> {
         self.store.set(p, sphere);
         self.store.entry[p] = Some((handle, filter, value));
         self.nodes[node].len = len + 1;
+        self.widen_filters(node, filter);
         *self
             .items
             .get_by_index_mut(handle.index())
             .expect("placing a live item") = Loc { node, pos: len };
+    }
+
+    /// ORs `filter` into the filter bits of `node` and its ancestors, stopping
+    /// where they already hold it. O(depth), usually O(1).
+    pub(super) fn widen_filters(&mut self, mut node: u32, filter: Filter) {
+        while node != NIL {
+            let n = &mut self.nodes[node];
+            let (g, m) = (n.groups | filter.group, n.masks | filter.mask);
+            if (g, m) == (n.groups, n.masks) {
+                break;
+            }
+            (n.groups, n.masks) = (g, m);
+            node = n.parent;
+        }
     }
 
     /// Takes the object at `loc` out of its node ([sources: kd-remove]: `DeleteItem`) by moving the

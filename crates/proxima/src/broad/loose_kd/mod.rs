@@ -10,6 +10,7 @@
 //! `validate.rs`, `stats.rs`, `visit.rs` (read-only node walk for pictures).
 
 mod insert;
+mod nearest;
 mod node;
 mod pairs;
 #[cfg(feature = "parallel")]
@@ -346,8 +347,10 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     }
 
     fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
-        let p = self.position(*self.items.get(handle)?);
+        let loc = *self.items.get(handle)?;
+        let p = self.position(loc);
         self.store.entry[p].as_mut().expect("live position").1 = filter;
+        self.widen_filters(loc.node, filter);
         Ok(())
     }
 
@@ -401,7 +404,22 @@ impl<T> Walk<T> for LooseKdTree<T> {
         query: &Q,
         f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        self.visit_impl(query, f)
+        self.visit_impl(query, (), f)
+    }
+
+    /// The same walk, skipping every subtree whose filter bits (the OR of its
+    /// objects' groups and masks) cannot interact with `filter`, and every
+    /// object whose own filter does not.
+    fn walk_filtered<Q: Selection + ?Sized>(
+        &self,
+        query: &Q,
+        filter: Option<Filter>,
+        f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        match filter {
+            None => self.visit_impl(query, (), f),
+            Some(q) => self.visit_impl(query, q, f),
+        }
     }
 
     /// Node-vs-node walk over the nodes' contiguous objects (see `pairs.rs`). Its
@@ -423,9 +441,28 @@ impl<T> Walk<T> for LooseKdTree<T> {
         self.items.len()
     }
 
+    /// Branch and bound over the node regions (`nearest.rs`).
+    fn knn_into(
+        &self,
+        query: &crate::broad::Nearest,
+        filter: Option<Filter>,
+        out: &mut Vec<crate::broad::Neighbor>,
+    ) {
+        self.nearest_impl(query, filter, out)
+    }
+
     /// Front-to-back: nearer child first, subtrees whose region the ray enters
     /// after the best hit so far are skipped.
     fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
-        self.ray_first_impl(ray, filter)
+        self.first_impl(ray, filter)
+    }
+
+    /// The same front-to-back search, pruning by the sweep's box entry.
+    fn first_sweep_hit(
+        &self,
+        sweep: &crate::geom::SphereSweep,
+        filter: Option<Filter>,
+    ) -> Option<RayHit> {
+        self.first_impl(sweep, filter)
     }
 }

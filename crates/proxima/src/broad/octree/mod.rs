@@ -6,6 +6,7 @@
 
 mod code;
 mod insert;
+mod nearest;
 mod neighbors;
 mod node;
 mod pairs;
@@ -282,7 +283,10 @@ impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
     }
 
     fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
-        self.objects.get_mut(handle)?.filter = filter;
+        let o = self.objects.get_mut(handle)?;
+        o.filter = filter;
+        let leaf = o.leaf;
+        self.widen_filters(leaf, filter);
         Ok(())
     }
 
@@ -321,7 +325,22 @@ impl<T> Walk<T> for LinearOctree<T> {
         query: &Q,
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        self.visit_tree(query, &mut f)
+        self.visit_tree(query, (), &mut f)
+    }
+
+    /// The same walk, skipping every subtree whose filter bits (the OR of its
+    /// objects' groups and masks) cannot interact with `filter`, and every
+    /// object whose own filter does not.
+    fn walk_filtered<Q: Selection + ?Sized>(
+        &self,
+        query: &Q,
+        filter: Option<Filter>,
+        mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        match filter {
+            None => self.visit_tree(query, (), &mut f),
+            Some(q) => self.visit_tree(query, q, &mut f),
+        }
     }
 
     fn walk_pairs(
@@ -339,9 +358,28 @@ impl<T> Walk<T> for LinearOctree<T> {
         self.objects.len()
     }
 
+    /// Branch and bound over the loose boxes (`nearest.rs`).
+    fn knn_into(
+        &self,
+        query: &crate::broad::Nearest,
+        filter: Option<Filter>,
+        out: &mut Vec<crate::broad::Neighbor>,
+    ) {
+        self.nearest_tree(query, filter, out)
+    }
+
     /// Front-to-back: children in order of entry along the ray, subtrees entered
     /// after the best hit so far skipped.
     fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
-        self.ray_first_tree(ray, filter)
+        self.first_tree(ray, filter)
+    }
+
+    /// The same front-to-back search, pruning by the sweep's box entry.
+    fn first_sweep_hit(
+        &self,
+        sweep: &crate::geom::SphereSweep,
+        filter: Option<Filter>,
+    ) -> Option<RayHit> {
+        self.first_tree(sweep, filter)
     }
 }

@@ -7,7 +7,7 @@
 //! two spheres at distance exactly `r1 + r2` overlap.
 
 mod aabb;
-mod exact;
+pub(crate) mod exact;
 mod frustum;
 mod line_ball;
 pub mod overlap;

@@ -94,7 +94,7 @@ pub fn end_state(trace: &Trace) -> Vec<Sphere> {
     let mut live: Vec<Option<Sphere>> = vec![None; trace.ids.len()];
     for op in &trace.ops {
         match op {
-            Op::Insert { slot, sphere } | Op::Move { slot, sphere } => {
+            Op::Insert { slot, sphere, .. } | Op::Move { slot, sphere } => {
                 live[*slot as usize] = Some(*sphere)
             }
             Op::Remove { slot } => live[*slot as usize] = None,

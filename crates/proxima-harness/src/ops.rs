@@ -7,12 +7,17 @@
 //! negative radii, stale and foreign handles, bad constructor parameters. Every
 //! index must give the same answers and the same errors as brute force, leave
 //! itself unchanged after an error, and pass `validate()` after every operation.
+//!
+//! Collision filters, k-nearest queries and sphere sweeps are derived from the
+//! numbers the older operations already decode (no byte is read for them), so
+//! every saved input still decodes to the same operations.
 
 use proxima::broad::{
-    BruteForce, Grid2dConfig, Grid3dConfig, HashGrid, HashGridConfig, LinearOctree, LooseKdConfig,
-    LooseKdTree, OctreeConfig, Query, SpatialIndex, SpatialIndexExt, UniformGrid2d, UniformGrid3d,
+    BruteForce, Filter, Grid2dConfig, Grid3dConfig, HashGrid, HashGridConfig, LinearOctree,
+    LooseKdConfig, LooseKdTree, Metric, Nearest, OctreeConfig, Query, SpatialIndex,
+    SpatialIndexExt, UniformGrid2d, UniformGrid3d,
 };
-use proxima::geom::{Aabb, Frustum, Plane, Ray, Segment, Sphere};
+use proxima::geom::{Aabb, Frustum, Plane, Ray, Segment, Sphere, SphereSweep};
 use proxima::glam::{Mat4, Vec3};
 use proxima::{Error, Handle, Result};
 use std::ops::{ControlFlow, Deref, DerefMut};
@@ -154,8 +159,49 @@ impl Named {
     fn ray_first(&self, r: &Ray) -> Result<Option<(u32, f32)>> {
         Ok(self
             .index
-            .ray_first(r)?
+            .ray_first(r, None)?
             .map(|h| (*self.index.get(h.handle).unwrap().1, h.t)))
+    }
+    /// A filtered query's ids (sorted).
+    fn filtered_ids(&self, q: &Query, f: Filter) -> Result<Vec<u32>> {
+        let mut v = Vec::new();
+        let r = self.index.visit(q, Some(f), &mut |_, _, &x| {
+            v.push(x);
+            ControlFlow::Continue(())
+        });
+        ids(r, v)
+    }
+    /// Every sweep hit as (id, `t` bits), sorted, and the first hit.
+    #[allow(clippy::type_complexity)]
+    fn sweep(
+        &self,
+        sw: &SphereSweep,
+        f: Option<Filter>,
+    ) -> Result<(Vec<(u32, u32)>, Option<(Handle, f32)>)> {
+        let hits = match f {
+            None => self.index.sweep_hits(sw)?,
+            Some(f) => self.index.filtered(f).sweep_hits(sw)?,
+        };
+        let first = self.index.sweep_first(sw, f)?;
+        assert_eq!(first, hits.first().copied(), "{}: sweep first", self.name);
+        let mut v: Vec<(u32, u32)> = hits
+            .iter()
+            .map(|h| (*self.index.get(h.handle).unwrap().1, h.t.to_bits()))
+            .collect();
+        v.sort_unstable();
+        Ok((v, first.map(|h| (h.handle, h.t))))
+    }
+    /// A k-nearest answer as (handle, id, distance bits), in order.
+    fn nearest(&self, q: &Nearest, f: Option<Filter>) -> Result<Vec<(Handle, u32, u32)>> {
+        let mut out = Vec::new();
+        self.index.nearest_into(q, f, &mut out)?;
+        Ok(out
+            .iter()
+            .map(|n| {
+                let id = *self.index.get(n.handle).unwrap().1;
+                (n.handle, id, n.distance.to_bits())
+            })
+            .collect())
     }
     fn pairs(&self) -> Vec<(u32, u32)> {
         let mut v = Vec::new();
@@ -354,6 +400,95 @@ fn same<R: PartialEq + std::fmt::Debug>(what: &str, idx: &[Named], f: impl Fn(&N
     }
 }
 
+/// The bits of a sphere's numbers, mixed: the seed of derived choices.
+fn bits(s: &Sphere) -> u32 {
+    let c = s.center;
+    (c.x.to_bits() ^ c.y.to_bits().rotate_left(7) ^ c.z.to_bits().rotate_left(13))
+        .wrapping_mul(0x9e37_79b9)
+        ^ s.radius.to_bits()
+}
+
+/// A filter derived from `x`: [`Filter::ALL`] half the time, else a few bits
+/// (both answers of `interacts` common), sometimes inert.
+fn derived_filter(x: u32) -> Filter {
+    let y = x >> 3;
+    match x % 8 {
+        0..=3 => Filter::ALL,
+        4 => Filter::new(y % 2, (y >> 1) % 8),
+        _ => Filter::new(1 << (y % 3), 1 + (y >> 2) % 7),
+    }
+}
+
+/// Handle of object `id` in index number `pos`.
+fn handle_of(objs: &[Obj], pos: usize, id: u32) -> Handle {
+    objs.iter()
+        .find(|o| o.id == id)
+        .map(|o| o.handles[pos])
+        .expect("a live id")
+}
+
+/// k nearest around the query sphere's centre (k and the limit derived from
+/// its radius, both metrics, filtered or not): every index gives brute
+/// force's ranking, ties in its own handle order, and the same errors.
+fn check_nearest(idx: &[Named], objs: &[Obj], s: &Sphere, f: Filter) {
+    let x = bits(s);
+    let k = match x % 5 {
+        0 => 1,
+        1 => 8,
+        2 => 64,
+        3 => objs.len() + 1,
+        _ => (x >> 8) as usize % 4,
+    };
+    let mut q = Nearest::new(s.center, k);
+    if x & 64 != 0 {
+        q = q.metric(Metric::Center);
+    }
+    if x & 128 != 0 {
+        q = q.within(s.radius);
+    }
+    let filter = (f != Filter::ALL).then_some(f);
+    let all = idx[0].nearest(&Nearest { k: usize::MAX, ..q }, filter);
+    for (pos, i) in idx.iter().enumerate() {
+        let got = i.nearest(&q, filter);
+        let want = all.clone().map(|all| {
+            let mut v: Vec<(Handle, u32, u32)> = all
+                .iter()
+                .map(|&(_, id, d)| (handle_of(objs, pos, id), id, d))
+                .collect();
+            v.sort_unstable_by(|a, b| {
+                f32::from_bits(a.2)
+                    .total_cmp(&f32::from_bits(b.2))
+                    .then(a.0.cmp(&b.0))
+            });
+            v.truncate(k);
+            v
+        });
+        assert_eq!(got, want, "{}: nearest {q:?} {filter:?}", i.name());
+    }
+}
+
+/// A sphere sweep: the same hits and times in every index, the same first
+/// hit (ties in each index's own handle order), the same errors.
+fn check_sweep(idx: &[Named], objs: &[Obj], sw: &SphereSweep, f: Option<Filter>) {
+    let want = idx[0].sweep(sw, f).map(|x| x.0);
+    for (pos, i) in idx.iter().enumerate() {
+        let got = i.sweep(sw, f);
+        assert_eq!(got.clone().map(|x| x.0), want, "{}: sweep {sw:?}", i.name());
+        if let (Ok((_, first)), Ok(hits)) = (got, &want) {
+            let best = hits
+                .iter()
+                .map(|&(id, t)| (f32::from_bits(t), handle_of(objs, pos, id)))
+                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            assert_eq!(
+                first.map(|(h, t)| (t.to_bits(), h)),
+                best.map(|(t, h)| (t.to_bits(), h)),
+                "{}: sweep first {sw:?}",
+                i.name()
+            );
+        }
+    }
+}
+
 /// Checks what must hold after every operation.
 fn check(idx: &[Named], live: usize) {
     for i in idx {
@@ -387,8 +522,17 @@ pub fn run(data: &[u8]) {
                 if debug {
                     eprintln!("  insert {s:?}");
                 }
-                let res: Vec<Result<Handle>> =
-                    idx.iter_mut().map(|i| i.insert(s, next_id)).collect();
+                let f = derived_filter(bits(&s));
+                let res: Vec<Result<Handle>> = idx
+                    .iter_mut()
+                    .map(|i| {
+                        if f == Filter::ALL {
+                            i.insert(s, next_id)
+                        } else {
+                            i.insert_with_filter(s, f, next_id)
+                        }
+                    })
+                    .collect();
                 let errs: Vec<Option<Error>> = res.iter().map(|r| r.clone().err()).collect();
                 assert!(
                     errs.iter().all(|e| *e == errs[0]),
@@ -463,10 +607,19 @@ pub fn run(data: &[u8]) {
                 let s = b.sphere();
                 same("sphere query", &idx, |i| i.ids_in(s));
                 same("early stop", &idx, |i| i.early_stop(&s));
+                let f = derived_filter(bits(&s) >> 3);
+                same("filtered sphere query", &idx, |i| {
+                    i.filtered_ids(&Query::Sphere(s), f)
+                });
+                check_nearest(&idx, &objs, &s, f);
             }
             9 => {
                 let bx = Aabb::new(b.vec3(), b.vec3());
                 same("aabb query", &idx, |i| i.ids_in(bx));
+                let f = derived_filter(bx.min.x.to_bits() ^ bx.max.y.to_bits());
+                same("filtered aabb query", &idx, |i| {
+                    i.filtered_ids(&Query::Aabb(bx), f)
+                });
             }
             10 => {
                 let f = frustum(&mut b);
@@ -506,6 +659,23 @@ pub fn run(data: &[u8]) {
                     eprintln!("  {seg:?}");
                 }
                 same("segment hits", &idx, |i| i.ray_hits(&seg.to_ray()));
+                // The segment swept by a sphere of the ray's `max_t` as radius
+                // (zero-length, radius 0, huge and invalid ones included).
+                let sw = SphereSweep::new(seg.a, seg.b, max_t);
+                let f = derived_filter(max_t.to_bits() ^ seg.a.x.to_bits());
+                let f = (f != Filter::ALL).then_some(f);
+                check_sweep(&idx, &objs, &sw, f);
+                if sw.radius == 0.0 && sw.validate().is_ok() {
+                    let d = sw.to - sw.from;
+                    if sw.from + d == sw.to && sw.to - d == sw.from && d != Vec3::ZERO {
+                        // An exact direction: radius 0 is the segment query.
+                        for i in &idx {
+                            let want = i.ray_hits(&Segment::new(sw.from, sw.to).to_ray());
+                            let got = i.sweep(&sw, None).map(|x| x.0);
+                            assert_eq!(got, want, "{}: radius-0 sweep = segment", i.name());
+                        }
+                    }
+                }
             }
             13 => same("pairs", &idx, |i| i.pairs()),
             14 => {
@@ -530,12 +700,18 @@ pub fn run(data: &[u8]) {
                 }
             }
             _ => {
-                // Same update on an object, twice (a no-op move), then a get.
+                // Same update on an object, twice (a no-op move), then a get;
+                // then a new filter for it (derived from its id and the count).
                 if let Some(o) = objs.first() {
+                    let f = derived_filter(o.id.wrapping_mul(0x9e37_79b9) ^ next_id);
                     for (i, &h) in idx.iter_mut().zip(&o.handles) {
                         let (s, v) = i.get(h).unwrap();
                         assert_eq!(v, o.id);
+                        let before = i.filter(h).unwrap();
                         i.update(h, s).unwrap();
+                        assert_eq!(i.filter(h), Ok(before), "{}: move keeps filter", i.name());
+                        i.set_filter(h, f).unwrap();
+                        assert_eq!(i.filter(h), Ok(f), "{}: set_filter", i.name());
                     }
                 }
             }

@@ -6,7 +6,9 @@
 
 use crate::indices::BRUTE;
 use crate::trace::{Kind, Op, Query, Trace};
-use proxima::broad::{AnyIndex, IndexKind, SceneHint, SpatialIndex, SpatialIndexExt};
+use proxima::broad::{
+    AnyIndex, Filter, IndexKind, Nearest, Neighbor, SceneHint, SpatialIndex, SpatialIndexExt,
+};
 use proxima::geom::Sphere;
 use proxima::Handle;
 use std::fmt;
@@ -14,7 +16,7 @@ use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 
 /// The answer to one query line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Answer {
     /// Number of overlapping pairs.
     Pairs(usize),
@@ -27,6 +29,12 @@ pub enum Answer {
     Ray(usize, Option<u64>),
     /// Number of spheres kept by the frustum.
     Frustum(usize),
+    /// The user ids of the `min(K, live)` nearest objects, nearest first (ties
+    /// by smaller id).
+    Nearest(Vec<u64>),
+    /// Number of spheres the sweep touches and the user id of the first
+    /// (smallest time of impact, ties by smaller id), if any.
+    Sweep(usize, Option<u64>),
 }
 
 impl fmt::Display for Answer {
@@ -38,6 +46,12 @@ impl fmt::Display for Answer {
             Answer::Ray(n, Some(id)) => write!(f, "ray {n} {id}"),
             Answer::Ray(n, None) => write!(f, "ray {n} -"),
             Answer::Frustum(n) => write!(f, "frustum {n}"),
+            Answer::Nearest(ids) => {
+                write!(f, "nearest {}", ids.len())?;
+                ids.iter().try_for_each(|id| write!(f, " {id}"))
+            }
+            Answer::Sweep(n, Some(id)) => write!(f, "sweep {n} {id}"),
+            Answer::Sweep(n, None) => write!(f, "sweep {n} -"),
         }
     }
 }
@@ -97,9 +111,17 @@ fn apply(
     let live = |h: Option<Handle>| h.ok_or(proxima::Error::StaleHandle);
     let mut n = 0usize;
     Ok(Some(match op {
-        Op::Insert { slot, sphere } => {
+        Op::Insert {
+            slot,
+            sphere,
+            filter,
+        } => {
             let s = *slot as usize;
-            handles[s] = Some(index.insert(*sphere, ids[s])?);
+            handles[s] = Some(if *filter == Filter::ALL {
+                index.insert(*sphere, ids[s])?
+            } else {
+                index.insert_with_filter(*sphere, *filter, ids[s])?
+            });
             return Ok(None);
         }
         Op::Move { slot, sphere } => {
@@ -141,7 +163,43 @@ fn apply(
             }
             Answer::Ray(hits.len(), first)
         }
+        Op::Query(Query::Sweep(sw)) => {
+            // As for rays: among equal smallest times the smaller user id.
+            let hits = index.sweep_hits(sw)?;
+            let mut first = None;
+            if let Some(t0) = hits.first().map(|h| h.t) {
+                for h in hits.iter().take_while(|h| h.t == t0) {
+                    let id = *index.get(h.handle)?.1;
+                    first = Some(first.map_or(id, |f: u64| f.min(id)));
+                }
+            }
+            Answer::Sweep(hits.len(), first)
+        }
+        Op::Query(Query::Nearest { point, k }) => Answer::Nearest(nearest_ids(index, *point, *k)?),
     }))
+}
+
+/// The user ids of the `k` nearest to `point`, nearest first, ties by the
+/// smaller *user* id (the index breaks them by handle): when the `k`-th
+/// distance is tied, every object at most that far is fetched and ranked by
+/// (distance, id). The distances are the library's, the same in every index.
+fn nearest_ids(
+    index: &AnyIndex<u64>,
+    point: proxima::glam::Vec3,
+    k: usize,
+) -> proxima::Result<Vec<u64>> {
+    let mut out: Vec<Neighbor> = Vec::new();
+    index.nearest_into(&Nearest::new(point, k), None, &mut out)?;
+    if let Some(last) = out.last().filter(|_| out.len() == k) {
+        let all = Nearest::new(point, usize::MAX).within(last.distance);
+        index.nearest_into(&all, None, &mut out)?;
+    }
+    let mut ranked = out
+        .iter()
+        .map(|n| Ok((n.distance, *index.get(n.handle)?.1)))
+        .collect::<proxima::Result<Vec<(f32, u64)>>>()?;
+    ranked.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    Ok(ranked.into_iter().take(k).map(|(_, id)| id).collect())
 }
 
 /// A query callback that counts what it is given.
@@ -207,6 +265,10 @@ mod tests {
         assert_eq!(Answer::Ray(2, Some(7)).to_string(), "ray 2 7");
         assert_eq!(Answer::Ray(0, None).to_string(), "ray 0 -");
         assert_eq!(Answer::Frustum(0).to_string(), "frustum 0");
+        assert_eq!(Answer::Nearest(vec![4, 2]).to_string(), "nearest 2 4 2");
+        assert_eq!(Answer::Nearest(vec![]).to_string(), "nearest 0");
+        assert_eq!(Answer::Sweep(3, Some(9)).to_string(), "sweep 3 9");
+        assert_eq!(Answer::Sweep(0, None).to_string(), "sweep 0 -");
     }
 
     #[test]

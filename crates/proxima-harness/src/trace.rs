@@ -17,8 +17,8 @@
 //! that line's arm by its field count, and carried as a field of its [`Op`].
 
 use crate::lex::{self, expect_fields, numbers, ParseError, Res};
-use proxima::broad::SceneHint;
-use proxima::geom::{Aabb, Frustum, Ray, Sphere};
+use proxima::broad::{Filter, SceneHint};
+use proxima::geom::{Aabb, Frustum, Ray, Sphere, SphereSweep};
 use proxima::glam::{Mat4, Vec3};
 use std::collections::HashMap;
 
@@ -35,6 +35,15 @@ pub enum Query {
     Ray(Ray),
     /// `frustum M00 … M33` (boxed: it is much larger than the other variants).
     Frustum(Box<Frustum>),
+    /// `nearest X Y Z K`: the `K` nearest by surface distance, ties by id.
+    Nearest {
+        /// The query point.
+        point: Vec3,
+        /// How many.
+        k: usize,
+    },
+    /// `sweep X0 Y0 Z0 X1 Y1 Z1 R`.
+    Sweep(SphereSweep),
 }
 
 /// One operation. `slot` is the dense number of the user id (see [`Trace::ids`]).
@@ -46,6 +55,8 @@ pub enum Op {
         slot: u32,
         /// Its sphere.
         sphere: Sphere,
+        /// Its collision filter (`GROUP MASK`; [`Filter::ALL`] when absent).
+        filter: Filter,
     },
     /// Move/resize the object `slot`.
     Move {
@@ -75,11 +86,13 @@ pub enum Kind {
     Aabb,
     Ray,
     Frustum,
+    Nearest,
+    Sweep,
 }
 
 impl Kind {
     /// Every kind, in table order.
-    pub const ALL: [Kind; 8] = [
+    pub const ALL: [Kind; 10] = [
         Kind::Insert,
         Kind::Move,
         Kind::Remove,
@@ -88,6 +101,8 @@ impl Kind {
         Kind::Aabb,
         Kind::Ray,
         Kind::Frustum,
+        Kind::Nearest,
+        Kind::Sweep,
     ];
 
     /// The trace keyword.
@@ -101,6 +116,8 @@ impl Kind {
             Kind::Aabb => "aabb",
             Kind::Ray => "ray",
             Kind::Frustum => "frustum",
+            Kind::Nearest => "nearest",
+            Kind::Sweep => "sweep",
         }
     }
 }
@@ -117,6 +134,8 @@ impl Op {
             Op::Query(Query::Aabb(_)) => Kind::Aabb,
             Op::Query(Query::Ray(_)) => Kind::Ray,
             Op::Query(Query::Frustum(_)) => Kind::Frustum,
+            Op::Query(Query::Nearest { .. }) => Kind::Nearest,
+            Op::Query(Query::Sweep(_)) => Kind::Sweep,
         }
     }
 }
@@ -187,13 +206,21 @@ impl Parser {
         let args = line.args();
         let op = match cmd {
             "insert" | "move" => {
-                expect_fields(cmd, args, &["ID", "X", "Y", "Z", "R"])?;
+                const FIELDS: [&str; 7] = ["ID", "X", "Y", "Z", "R", "GROUP", "MASK"];
+                // `insert` takes an optional collision filter after the sphere.
+                let filter = if cmd == "insert" && args.len() == FIELDS.len() {
+                    Filter::new(bits(args[5], "GROUP")?, bits(args[6], "MASK")?)
+                } else {
+                    expect_fields(cmd, args, &FIELDS[..5])?;
+                    Filter::ALL
+                };
                 let id = lex::id(args[0])?;
-                let sphere = lex::sphere(&args[1..])?;
+                let sphere = lex::sphere(&args[1..5])?;
                 if cmd == "insert" {
                     Op::Insert {
                         slot: self.insert(id)?,
                         sphere,
+                        filter,
                     }
                 } else {
                     Op::Move {
@@ -245,6 +272,31 @@ impl Parser {
                     .map_err(|e| format!("bad view-projection matrix: {e}"))?;
                 Op::Query(Query::Frustum(Box::new(fr)))
             }
+            "nearest" => {
+                expect_fields(cmd, args, &["X", "Y", "Z", "K"])?;
+                let v = numbers::<3>(cmd, &args[..3], &["X", "Y", "Z"])?;
+                let k = args[3].parse::<usize>().map_err(|_| {
+                    format!(
+                        "bad K '{}' (expected an unsigned integer)",
+                        lex::clip(args[3])
+                    )
+                })?;
+                Op::Query(Query::Nearest {
+                    point: Vec3::new(v[0], v[1], v[2]),
+                    k,
+                })
+            }
+            "sweep" => {
+                let names = ["X0", "Y0", "Z0", "X1", "Y1", "Z1", "R"];
+                let v = numbers::<7>(cmd, args, &names)?;
+                let sw = SphereSweep::new(
+                    Vec3::new(v[0], v[1], v[2]),
+                    Vec3::new(v[3], v[4], v[5]),
+                    v[6],
+                );
+                sw.validate().map_err(|e| e.to_string())?;
+                Op::Query(Query::Sweep(sw))
+            }
             other => return Err(format!("unknown command '{}'", lex::clip(other))),
         };
         self.trace.ops.push(op);
@@ -276,6 +328,16 @@ impl Parser {
             _ => Err(format!("unknown id {id}")),
         }
     }
+}
+
+/// A `GROUP` or `MASK` field: a 32-bit unsigned integer.
+fn bits(s: &str, name: &str) -> Res<u32> {
+    s.parse().map_err(|_| {
+        format!(
+            "bad {name} '{}' (expected a 32-bit unsigned integer)",
+            lex::clip(s)
+        )
+    })
 }
 
 #[cfg(test)]
@@ -333,6 +395,53 @@ mod tests {
         // A zero matrix is degenerate but defined (zero-normal planes keep all).
         assert!(Trace::parse(b"frustum 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0").is_ok());
         assert!(Trace::parse(b"insert 1 0 0 0 1\n\xff\n").unwrap_err().line == 2);
+    }
+
+    #[test]
+    fn parses_filters_nearest_and_sweeps() {
+        let t = Trace::parse(
+            b"insert 1 0 0 0 1 4294967295 1\ninsert 2 0 0 0 1\nnearest 1 2 3 0\n\
+              nearest 0 0 0 18446744073709551615\nsweep 0 0 0 1 1 1 0\nsweep 2 2 2 2 2 2 0.5\n",
+        )
+        .unwrap();
+        let kinds: Vec<_> = t.ops.iter().map(|o| o.kind().name()).collect();
+        assert_eq!(
+            kinds,
+            ["insert", "insert", "nearest", "nearest", "sweep", "sweep"]
+        );
+        let filters: Vec<Filter> = t
+            .ops
+            .iter()
+            .filter_map(|o| match o {
+                Op::Insert { filter, .. } => Some(*filter),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(filters, [Filter::new(u32::MAX, 1), Filter::ALL]);
+        assert_eq!(
+            t.ops[3],
+            Op::Query(Query::Nearest {
+                point: Vec3::ZERO,
+                k: usize::MAX
+            })
+        );
+        assert_eq!(t.query_count(), 4);
+        // Bad filters, counts and sweeps name what is wrong.
+        assert!(err("insert 1 0 0 0 1 4294967296 1")
+            .message
+            .contains("bad GROUP"));
+        assert!(err("insert 1 0 0 0 1 1 -1").message.contains("bad MASK"));
+        assert!(err("insert 1 0 0 0 1 1")
+            .message
+            .contains("expects 5 fields"));
+        assert!(err("move 1 0 0 0 1 1 1")
+            .message
+            .contains("expects 5 fields"));
+        assert!(err("nearest 0 0 0 -1").message.contains("bad K"));
+        assert!(err("nearest 0 0 0").message.contains("expects 4 fields"));
+        assert!(err("nearest 0 nan 0 1").message.contains("not finite"));
+        assert!(err("sweep 0 0 0 1 1 1 -1").message.contains("negative"));
+        assert!(err("sweep 0 0 0 1 1 inf 1").message.contains("not finite"));
     }
 
     #[test]

@@ -97,7 +97,7 @@ fn chunk(index: &AnyIndex<u64>, queries: &[Query]) -> Csr {
 /// `(id, t)`, or `(-1, inf)` for a miss. The rays must be validated.
 pub fn first_hits(index: &AnyIndex<u64>, rays: &[Ray], workers: &Workers) -> (Vec<i64>, Vec<f32>) {
     let one = |r: &Ray| -> (i64, f32) {
-        match index.ray_first(r) {
+        match index.ray_first(r, None) {
             Ok(Some(hit)) => match index.get(hit.handle) {
                 Ok((_, &id)) => (id as i64, hit.t),
                 Err(_) => (-1, f32::INFINITY),

@@ -196,6 +196,17 @@ pub(crate) fn check_vec3(v: glam::Vec3, what: &'static str) -> Result<()> {
     }
 }
 
+/// Checks that a radius is finite (`what` names it) and not negative.
+pub(crate) fn check_radius(radius: f32, what: &'static str) -> Result<()> {
+    if !radius.is_finite() {
+        return Err(Error::NonFinite { what });
+    }
+    if radius < 0.0 {
+        return Err(Error::NegativeRadius { radius });
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

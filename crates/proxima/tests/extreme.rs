@@ -122,7 +122,7 @@ fn hundred_k_at_one_point<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
     assert!(i.query(b).unwrap().is_empty());
     let r = Ray::new(p - vec3(10.0, 0.0, 0.0), Vec3::X);
     assert_eq!(i.ray_hits(&r).unwrap().len(), N_POINT as usize);
-    assert_eq!(i.ray_first(&r).unwrap().unwrap().t, 9.0);
+    assert_eq!(i.ray_first(&r, None).unwrap().unwrap().t, 9.0);
     // Early stop is honoured.
     let mut n = 0;
     let _ = i.for_each_in(Sphere::new(p, 1.0), |_, _, _| {
@@ -613,7 +613,7 @@ fn grid2d_far_segment_end_hit() {
         g.insert(Sphere::new(Vec3::splat(-32.0), 0.0), 1).unwrap();
         assert_eq!(g.ray_hits(&ray).unwrap().len(), 1, "cell {cell}: ray_hits");
         assert_eq!(
-            g.ray_first(&ray).unwrap().map(|h| h.t),
+            g.ray_first(&ray, None).unwrap().map(|h| h.t),
             Some(1.0),
             "cell {cell}: ray_first"
         );
@@ -695,8 +695,8 @@ fn far_rays_agree<I: SpatialIndex<u32>>(mut i: I) -> usize {
                 assert_eq!(key(&i, &i.ray_hits(&ray).unwrap()), want, "{ray:?}");
                 let first = |j: Option<proxima::broad::RayHit>| j.map(|h| h.t.to_bits());
                 assert_eq!(
-                    first(i.ray_first(&ray).unwrap()),
-                    first(b.ray_first(&ray).unwrap()),
+                    first(i.ray_first(&ray, None).unwrap()),
+                    first(b.ray_first(&ray, None).unwrap()),
                     "{ray:?}"
                 );
             }

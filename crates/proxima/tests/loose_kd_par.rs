@@ -6,10 +6,10 @@
 #![cfg(feature = "parallel")]
 
 use proxima::broad::{
-    BruteForce, IndexKind, LooseKdConfig, LooseKdTree, ParallelPairs, Query, RayHit, SpatialIndex,
-    SpatialIndexExt,
+    BruteForce, Filter, IndexKind, LooseKdConfig, LooseKdTree, Nearest, Neighbor, ParallelPairs,
+    Query, RayHit, SpatialIndex, SpatialIndexExt, SweepHit,
 };
-use proxima::geom::{Ray, Sphere};
+use proxima::geom::{Ray, Sphere, SphereSweep};
 use proxima::glam::Vec3;
 use proxima::{Handle, Result};
 use proxima_harness::oracle::{run, SceneParams, ALL_SCENES};
@@ -36,8 +36,14 @@ impl ParCheck {
 }
 
 impl SpatialIndex<u64> for ParCheck {
-    fn insert(&mut self, sphere: Sphere, value: u64) -> Result<Handle> {
-        self.tree.insert(sphere, value)
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: u64) -> Result<Handle> {
+        self.tree.insert_with_filter(sphere, filter, value)
+    }
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        self.tree.filter(handle)
+    }
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        self.tree.set_filter(handle, filter)
     }
     fn remove(&mut self, handle: Handle) -> Result<u64> {
         self.tree.remove(handle)
@@ -63,9 +69,10 @@ impl SpatialIndex<u64> for ParCheck {
     fn visit(
         &self,
         query: &Query,
+        filter: Option<Filter>,
         f: &mut dyn FnMut(Handle, &Sphere, &u64) -> ControlFlow<()>,
     ) -> Result<ControlFlow<()>> {
-        self.tree.visit(query, f)
+        self.tree.visit(query, filter, f)
     }
     fn visit_pairs(
         &self,
@@ -84,8 +91,19 @@ impl SpatialIndex<u64> for ParCheck {
         assert_eq!(count, seq.len() as u64);
         self.tree.visit_pairs(f)
     }
-    fn ray_first(&self, ray: &Ray) -> Result<Option<RayHit>> {
-        self.tree.ray_first(ray)
+    fn ray_first(&self, ray: &Ray, filter: Option<Filter>) -> Result<Option<RayHit>> {
+        self.tree.ray_first(ray, filter)
+    }
+    fn sweep_first(&self, sweep: &SphereSweep, filter: Option<Filter>) -> Result<Option<SweepHit>> {
+        self.tree.sweep_first(sweep, filter)
+    }
+    fn nearest_into(
+        &self,
+        query: &Nearest,
+        filter: Option<Filter>,
+        out: &mut Vec<Neighbor>,
+    ) -> Result<()> {
+        self.tree.nearest_into(query, filter, out)
     }
     fn validate(&self) -> Result<()> {
         self.tree.validate()

@@ -124,7 +124,7 @@ impl Engine for Proxima {
             parallel: bool,
         ) -> Vec<usize> {
             if parallel {
-                par_query_counts(index, qs).expect("valid queries")
+                par_query_counts(index, qs, None).expect("valid queries")
             } else {
                 qs.iter().map(|&q| visit_count(index, q)).collect()
             }

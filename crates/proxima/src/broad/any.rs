@@ -3,11 +3,11 @@
 
 use super::walk::{self, Walk};
 use super::{
-    BruteForce, Grid2dConfig, Grid3dConfig, HashGrid, HashGridConfig, IndexKind, LinearOctree,
-    LooseKdConfig, LooseKdTree, OctreeConfig, Query, RayHit, SceneHint, SpatialIndex,
-    UniformGrid2d, UniformGrid3d,
+    BruteForce, Filter, Grid2dConfig, Grid3dConfig, HashGrid, HashGridConfig, IndexKind,
+    LinearOctree, LooseKdConfig, LooseKdTree, Nearest, Neighbor, OctreeConfig, Query, RayHit,
+    SceneHint, SpatialIndex, SweepHit, UniformGrid2d, UniformGrid3d,
 };
-use crate::geom::{Ray, Sphere};
+use crate::geom::{Ray, Sphere, SphereSweep};
 use crate::{Handle, Result};
 use std::ops::ControlFlow;
 
@@ -70,15 +70,16 @@ impl<T> AnyIndex<T> {
         })
     }
 
-    /// [`SpatialIndex::visit`] with a closure, statically dispatched: the
-    /// index's walk for the query's shape runs with `f` inlined.
+    /// [`SpatialIndex::visit`] (unfiltered) with a closure, statically
+    /// dispatched: the index's walk for the query's shape runs with `f`
+    /// inlined.
     pub fn for_each_in(
         &self,
         query: impl Into<Query>,
         f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> Result<ControlFlow<()>> {
         let query = query.into();
-        each!(self, i => walk::visit(i, &query, f))
+        each!(self, i => walk::visit(i, &query, None, f))
     }
 
     /// [`SpatialIndex::visit_pairs`] with a closure, statically dispatched (the
@@ -133,6 +134,10 @@ impl<T: Send + Sync> SpatialIndex<T> for AnyIndex<T> {
         each!(self, i => i.insert(sphere, value))
     }
     #[inline]
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
+        each!(self, i => i.insert_with_filter(sphere, filter, value))
+    }
+    #[inline]
     fn remove(&mut self, handle: Handle) -> Result<T> {
         each!(self, i => i.remove(handle))
     }
@@ -148,6 +153,12 @@ impl<T: Send + Sync> SpatialIndex<T> for AnyIndex<T> {
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
         each!(self, i => i.get_mut(handle))
     }
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        each!(self, i => i.filter(handle))
+    }
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        each!(self, i => i.set_filter(handle, filter))
+    }
     fn len(&self) -> usize {
         each!(self, i => i.len())
     }
@@ -160,9 +171,10 @@ impl<T: Send + Sync> SpatialIndex<T> for AnyIndex<T> {
     fn visit(
         &self,
         query: &Query,
+        filter: Option<Filter>,
         f: &mut dyn FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> Result<ControlFlow<()>> {
-        each!(self, i => walk::visit(i, query, f))
+        each!(self, i => walk::visit(i, query, filter, f))
     }
     fn visit_pairs(
         &self,
@@ -170,9 +182,24 @@ impl<T: Send + Sync> SpatialIndex<T> for AnyIndex<T> {
     ) -> ControlFlow<()> {
         each!(self, i => i.walk_pairs(f))
     }
-    fn ray_first(&self, ray: &Ray) -> Result<Option<RayHit>> {
+    fn ray_first(&self, ray: &Ray, filter: Option<Filter>) -> Result<Option<RayHit>> {
         ray.validate()?;
-        Ok(each!(self, i => i.first_hit(ray)))
+        Ok(each!(self, i => i.first_hit(ray, filter)))
+    }
+    fn sweep_first(&self, sweep: &SphereSweep, filter: Option<Filter>) -> Result<Option<SweepHit>> {
+        sweep.validate()?;
+        Ok(each!(self, i => i.first_sweep_hit(sweep, filter)))
+    }
+    fn nearest_into(
+        &self,
+        query: &Nearest,
+        filter: Option<Filter>,
+        out: &mut Vec<Neighbor>,
+    ) -> Result<()> {
+        out.clear();
+        query.validate()?;
+        each!(self, i => i.knn_into(query, filter, out));
+        Ok(())
     }
     fn validate(&self) -> Result<()> {
         each!(self, i => SpatialIndex::validate(i))

@@ -2,20 +2,22 @@
 //! other indices are tested against, and the baseline of the benchmarks.
 
 use crate::arena::Arena;
+use crate::broad::nearest::{self, Nearest, Neighbor};
 use crate::broad::walk::{walk_methods, Walk};
-use crate::broad::{IndexKind, Selection, SpatialIndex};
+use crate::broad::{Filter, IndexKind, Selection, SpatialIndex};
 use crate::geom::{overlap, Sphere};
 use crate::{Handle, Result};
 use std::ops::ControlFlow;
 
 /// Stores spheres in a generational arena and answers every query by testing each one.
 ///
-/// Insert, remove and update are O(1); queries are O(n); pairs are O(n²). Its
+/// Insert, remove and update are O(1); queries are O(n); pairs are O(n²); k
+/// nearest is one scan and a selection of the `k` smallest, O(n + k log k). Its
 /// answers are the definition of right for every other index (same closed tests
-/// from [`geom::overlap`](crate::geom::overlap)).
+/// and distances from [`geom::overlap`](crate::geom::overlap)).
 #[derive(Clone, Debug)]
 pub struct BruteForce<T> {
-    items: Arena<(Sphere, T)>,
+    items: Arena<(Sphere, Filter, T)>,
 }
 
 impl<T> Default for BruteForce<T> {
@@ -36,13 +38,13 @@ impl<T> BruteForce<T> {
 }
 
 impl<T: Send + Sync> SpatialIndex<T> for BruteForce<T> {
-    fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
         sphere.validate()?;
-        self.items.insert((sphere, value))
+        self.items.insert((sphere, filter, value))
     }
 
     fn remove(&mut self, handle: Handle) -> Result<T> {
-        self.items.remove(handle).map(|(_, v)| v)
+        self.items.remove(handle).map(|(_, _, v)| v)
     }
 
     fn update(&mut self, handle: Handle, sphere: Sphere) -> Result<()> {
@@ -52,11 +54,20 @@ impl<T: Send + Sync> SpatialIndex<T> for BruteForce<T> {
     }
 
     fn get(&self, handle: Handle) -> Result<(Sphere, &T)> {
-        self.items.get(handle).map(|(s, v)| (*s, v))
+        self.items.get(handle).map(|(s, _, v)| (*s, v))
     }
 
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
-        self.items.get_mut(handle).map(|(_, v)| v)
+        self.items.get_mut(handle).map(|(_, _, v)| v)
+    }
+
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        self.items.get(handle).map(|(_, f, _)| *f)
+    }
+
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        self.items.get_mut(handle)?.1 = filter;
+        Ok(())
     }
 
     fn len(&self) -> usize {
@@ -68,7 +79,7 @@ impl<T: Send + Sync> SpatialIndex<T> for BruteForce<T> {
     }
 
     fn for_each(&self, f: &mut dyn FnMut(Handle, &Sphere, &T)) {
-        for (h, (s, v)) in self.items.iter() {
+        for (h, (s, _, v)) in self.items.iter() {
             f(h, s, v);
         }
     }
@@ -94,7 +105,7 @@ impl<T> Walk<T> for BruteForce<T> {
         query: &Q,
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        for (h, (s, v)) in self.items.iter() {
+        for (h, (s, _, v)) in self.items.iter() {
             if query.selects(s) {
                 f(h, s, v)?;
             }
@@ -102,14 +113,58 @@ impl<T> Walk<T> for BruteForce<T> {
         ControlFlow::Continue(())
     }
 
+    /// The stored filter is at hand in the scan: test it there, before the
+    /// shape.
+    fn walk_filtered<Q: Selection + ?Sized>(
+        &self,
+        query: &Q,
+        filter: Option<Filter>,
+        mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        let Some(q) = filter else {
+            return self.walk(query, f);
+        };
+        for (h, (s, of, v)) in self.items.iter() {
+            if q.interacts(*of) && query.selects(s) {
+                f(h, s, v)?;
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    fn filter_of(&self, h: Handle) -> Filter {
+        self.items.get(h).expect("a live handle").1
+    }
+
+    fn object_count(&self) -> usize {
+        self.items.len()
+    }
+
+    /// One scan: every admitted object's distance, then the `k` smallest.
+    fn knn_into(&self, q: &Nearest, filter: Option<Filter>, out: &mut Vec<Neighbor>) {
+        out.clear();
+        for (h, (s, of, _)) in self.items.iter() {
+            if filter.map_or(true, |f| f.interacts(*of)) {
+                let distance = q.metric.distance(q.point, s);
+                if distance <= q.max_distance {
+                    out.push(Neighbor {
+                        handle: h,
+                        distance,
+                    });
+                }
+            }
+        }
+        nearest::finish(out, q.k);
+    }
+
     fn walk_pairs(
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let all: Vec<_> = self.items.iter().collect();
-        for (i, (ha, (sa, va))) in all.iter().enumerate() {
-            for (hb, (sb, vb)) in &all[i + 1..] {
-                if overlap::sphere_sphere(sa, sb) {
+        for (i, (ha, (sa, fa, va))) in all.iter().enumerate() {
+            for (hb, (sb, fb, vb)) in &all[i + 1..] {
+                if fa.interacts(*fb) && overlap::sphere_sphere(sa, sb) {
                     f(*ha, va, *hb, vb)?;
                 }
             }
@@ -134,9 +189,9 @@ impl<T: Send + Sync> super::ParallelPairs<T> for BruteForce<T> {
         (0..all.len())
             .into_par_iter()
             .fold(&init, |mut acc, i| {
-                let (ha, (sa, va)) = all[i];
-                for (hb, (sb, vb)) in &all[i + 1..] {
-                    if overlap::sphere_sphere(sa, sb) {
+                let (ha, (sa, fa, va)) = all[i];
+                for (hb, (sb, fb, vb)) in &all[i + 1..] {
+                    if fa.interacts(*fb) && overlap::sphere_sphere(sa, sb) {
                         acc = fold(acc, ha, va, *hb, vb);
                     }
                 }

@@ -40,6 +40,16 @@ impl Filter {
         (self.group & other.mask) != 0 && (other.group & self.mask) != 0
     }
 
+    /// Whether this query filter may interact with some object of a set whose
+    /// groups are all within `groups` and masks all within `masks` (the OR of
+    /// the set's groups and masks, or any superset): `false` proves it
+    /// interacts with none, so an index may skip the whole set (a subtree whose
+    /// ORs it keeps). O(1).
+    #[inline]
+    pub const fn may_interact(self, groups: u32, masks: u32) -> bool {
+        (self.mask & groups) != 0 && (self.group & masks) != 0
+    }
+
     /// Whether this filter interacts with nothing (`group == 0 || mask == 0`):
     /// an index may leave such an object out of its pair search. O(1).
     #[inline]
@@ -52,6 +62,41 @@ impl Default for Filter {
     /// [`Filter::ALL`].
     fn default() -> Self {
         Filter::ALL
+    }
+}
+
+/// What an index walk reports besides the shape test: `()` everything (no
+/// code at all), a [`Filter`] the objects whose filter interacts with it,
+/// skipping the subtrees whose OR-ed filter bits cannot
+/// ([`Filter::may_interact`]). Lets one traversal serve filtered and
+/// unfiltered queries without a cost to the unfiltered one.
+pub(crate) trait Admit: Copy {
+    /// Whether a set of objects whose groups and masks are within `groups` and
+    /// `masks` may hold an admitted one.
+    fn node(&self, groups: u32, masks: u32) -> bool;
+    /// Whether an object with filter `f` is admitted.
+    fn object(&self, f: Filter) -> bool;
+}
+
+impl Admit for () {
+    #[inline(always)]
+    fn node(&self, _: u32, _: u32) -> bool {
+        true
+    }
+    #[inline(always)]
+    fn object(&self, _: Filter) -> bool {
+        true
+    }
+}
+
+impl Admit for Filter {
+    #[inline(always)]
+    fn node(&self, groups: u32, masks: u32) -> bool {
+        self.may_interact(groups, masks)
+    }
+    #[inline(always)]
+    fn object(&self, f: Filter) -> bool {
+        self.interacts(f)
     }
 }
 

@@ -36,7 +36,7 @@ mod any;
 mod brute;
 mod cell_grid;
 mod ext;
-mod filter;
+pub(crate) mod filter;
 mod grid2d;
 mod grid3d;
 mod hash_grid;
@@ -44,6 +44,7 @@ mod hint;
 mod index;
 mod kind;
 mod loose_kd;
+mod nearest;
 mod octree;
 #[cfg(feature = "parallel")]
 mod parallel;
@@ -55,18 +56,19 @@ pub(crate) mod walk;
 
 pub use any::AnyIndex;
 pub use brute::BruteForce;
-pub use ext::SpatialIndexExt;
+pub use ext::{Filtered, SpatialIndexExt};
 pub use filter::Filter;
 pub use grid2d::{Grid2dConfig, UniformGrid2d};
 pub use grid3d::{Grid3dConfig, UniformGrid3d};
 pub use hash_grid::{HashGrid, HashGridConfig};
 pub use hint::SceneHint;
-pub use index::{RayHit, SpatialIndex};
+pub use index::{RayHit, SpatialIndex, SweepHit};
 pub use kind::IndexKind;
 pub use loose_kd::{KdNodeView, KdStats, LooseKdConfig, LooseKdTree, Placement};
+pub use nearest::{Metric, Nearest, Neighbor};
 pub use octree::{Face, LinearOctree, LocationCode, OctreeConfig, OctreeStats};
 #[cfg(feature = "parallel")]
-pub use parallel::{par_query_counts, par_visit_batch, ParallelPairs};
+pub use parallel::{par_nearest, par_query_counts, par_visit_batch, NearestBatch, ParallelPairs};
 pub use query::Query;
 // Not part of the API: the index walks' view of a query, public only so that the
 // benchmark's peers can test their nodes with exactly the indices' tests. Sealed.

@@ -5,7 +5,7 @@
 //! Results are combined rayon-style (`init` / `fold` / `reduce`), so each thread
 //! accumulates into its own value and nothing is shared while pairs are found.
 
-use super::{Query, SpatialIndex};
+use super::{Filter, Nearest, Neighbor, Query, SpatialIndex};
 use crate::geom::Sphere;
 use crate::{Handle, Result};
 use rayon::prelude::*;
@@ -55,12 +55,17 @@ fn validate_all<Q: Into<Query> + Copy>(queries: &[Q]) -> Result<()> {
     queries.iter().try_for_each(|&q| q.into().validate())
 }
 
-/// Number of objects each query selects, `out[i]` for `queries[i]`, the queries
-/// split over rayon's threads (one [`SpatialIndex::visit`] per query; the index is
-/// shared read-only, which its `Sync` bound allows). Cost: the sequential queries
-/// divided over the pool's threads. Errors, before any query runs, if a query's
-/// numbers are invalid.
-pub fn par_query_counts<T, I, Q>(index: &I, queries: &[Q]) -> Result<Vec<usize>>
+/// Number of objects each query selects among those `filter` admits (see
+/// [`SpatialIndex`]'s filters), `out[i]` for `queries[i]`, the queries split
+/// over rayon's threads (one [`SpatialIndex::visit`] per query; the index is
+/// shared read-only, which its `Sync` bound allows). Cost: the sequential
+/// queries divided over the pool's threads. Errors, before any query runs, if a
+/// query's numbers are invalid.
+pub fn par_query_counts<T, I, Q>(
+    index: &I,
+    queries: &[Q],
+    filter: Option<Filter>,
+) -> Result<Vec<usize>>
 where
     I: SpatialIndex<T> + ?Sized,
     Q: Into<Query> + Copy + Sync,
@@ -70,7 +75,7 @@ where
         .par_iter()
         .map(|&q| {
             let mut n = 0usize;
-            let _ = index.visit(&q.into(), &mut |_, _, _| {
+            let _ = index.visit(&q.into(), filter, &mut |_, _, _| {
                 n += 1;
                 ControlFlow::Continue(())
             })?;
@@ -79,15 +84,18 @@ where
         .collect()
 }
 
-/// Folds every (query, selected object) of a batch into per-task accumulators made
-/// by `init` — `fold(acc, i, handle, sphere, value)` with `i` the query's position
-/// in `queries` — then merges them with `reduce` (rayon's fold/reduce). Objects are
-/// reported in no particular order across queries. Cost: the sequential queries
-/// divided over the pool's threads plus one `reduce` per task. Errors, before any
-/// query runs, if a query's numbers are invalid.
+/// Folds every (query, selected object) of a batch — the objects `filter`
+/// admits — into per-task accumulators made by `init` —
+/// `fold(acc, i, handle, sphere, value)` with `i` the query's position in
+/// `queries` — then merges them with `reduce` (rayon's fold/reduce). Objects
+/// are reported in no particular order across queries. Cost: the sequential
+/// queries divided over the pool's threads plus one `reduce` per task. Errors,
+/// before any query runs, if a query's numbers are invalid.
+#[allow(clippy::too_many_arguments)]
 pub fn par_visit_batch<T, I, Q, A, Init, F, R>(
     index: &I,
     queries: &[Q],
+    filter: Option<Filter>,
     init: Init,
     fold: F,
     reduce: R,
@@ -108,13 +116,92 @@ where
             // `visit` takes an `FnMut`, so the accumulator moves through an Option.
             let mut acc = Some(acc);
             // Validated above: the walk cannot fail.
-            let _ = index.visit(&q.into(), &mut |h, s, v| {
+            let _ = index.visit(&q.into(), filter, &mut |h, s, v| {
                 acc = acc.take().map(|a| fold(a, i, h, s, v));
                 ControlFlow::Continue(())
             });
             acc.expect("the accumulator is put back after every object")
         })
         .reduce(&init, &reduce))
+}
+
+/// The answers of a batch of k-nearest queries, flat: query `i`'s neighbours
+/// are `neighbors[offsets[i]..offsets[i + 1]]`, nearest first (the layout of
+/// ragged results that array libraries use).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NearestBatch {
+    /// Every query's neighbours, one query after another.
+    pub neighbors: Vec<Neighbor>,
+    /// `queries.len() + 1` positions into `neighbors`.
+    pub offsets: Vec<usize>,
+}
+
+impl NearestBatch {
+    /// Query `i`'s neighbours, nearest first. Panics if `i` is not a query of
+    /// the batch.
+    pub fn get(&self, i: usize) -> &[Neighbor] {
+        &self.neighbors[self.offsets[i]..self.offsets[i + 1]]
+    }
+
+    /// Number of queries.
+    pub fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// True for a batch of no queries.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Queries per rayon task of [`par_nearest`]: enough that a task's buffer
+/// warms up, few enough that two threads share the work evenly.
+const NEAREST_CHUNK: usize = 64;
+
+/// Runs [`SpatialIndex::nearest_into`] for every query of a batch (among the
+/// objects `filter` admits), the queries split over rayon's threads, and
+/// returns the answers flat ([`NearestBatch`]). Each task reuses one buffer
+/// for its queries, so the only allocations are the tasks' and the result's.
+/// Errors, before any query runs, if a query is invalid. Cost: the sequential
+/// queries divided over the pool's threads, plus copying the answers.
+pub fn par_nearest<T, I>(
+    index: &I,
+    queries: &[Nearest],
+    filter: Option<Filter>,
+) -> Result<NearestBatch>
+where
+    I: SpatialIndex<T> + ?Sized,
+{
+    queries.iter().try_for_each(Nearest::validate)?;
+    let parts: Vec<(Vec<Neighbor>, Vec<usize>)> = queries
+        .par_chunks(NEAREST_CHUNK)
+        .map(|chunk| {
+            let mut buf = Vec::new();
+            let mut flat = Vec::new();
+            let mut counts = Vec::with_capacity(chunk.len());
+            for q in chunk {
+                // Validated above: the search cannot fail.
+                let _ = index.nearest_into(q, filter, &mut buf);
+                counts.push(buf.len());
+                flat.extend_from_slice(&buf);
+            }
+            (flat, counts)
+        })
+        .collect();
+    let total = parts.iter().map(|(f, _)| f.len()).sum();
+    let mut out = NearestBatch {
+        neighbors: Vec::with_capacity(total),
+        offsets: Vec::with_capacity(queries.len() + 1),
+    };
+    out.offsets.push(0);
+    for (flat, counts) in parts {
+        out.neighbors.extend_from_slice(&flat);
+        for c in counts {
+            let last = *out.offsets.last().expect("starts with 0");
+            out.offsets.push(last + c);
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -167,13 +254,14 @@ mod tests {
         let seq = sequential(index, qs);
         let total: usize = seq.iter().map(Vec::len).sum();
         assert!(total > qs.len(), "the batch must select things: {total}");
-        let counts = pool.install(|| par_query_counts(index, qs)).unwrap();
+        let counts = pool.install(|| par_query_counts(index, qs, None)).unwrap();
         assert_eq!(counts, seq.iter().map(Vec::len).collect::<Vec<_>>());
         let mut lists = pool
             .install(|| {
                 par_visit_batch(
                     index,
                     qs,
+                    None,
                     || vec![Vec::new(); qs.len()],
                     |mut acc: Vec<Vec<Handle>>, i, h, _, _| {
                         acc[i].push(h);
@@ -246,6 +334,58 @@ mod tests {
         batches(&grid);
     }
 
+    /// The batch k-nearest search gives, per query, exactly the sequential
+    /// answer (filtered or not), in the flat layout, on a 2-thread pool, for
+    /// every index kind; a bad query fails the batch.
+    #[test]
+    fn par_nearest_matches_sequential() {
+        use crate::broad::{Filter, IndexKind, Metric, SceneHint};
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let mut next = rng(5);
+        let mut qs: Vec<Nearest> = (0..300)
+            .map(|i| {
+                let p = Vec3::new(next(), next(), next()) * 70.0 - Vec3::splat(5.0);
+                let q = Nearest::new(p, [0, 1, 8, 64, 5000][i % 5]);
+                match i % 3 {
+                    0 => q,
+                    1 => q.within(3.0),
+                    _ => q.metric(Metric::Center),
+                }
+            })
+            .collect();
+        qs.push(Nearest::new(Vec3::splat(1e7), 3));
+        let hint = SceneHint::new(Aabb::new(Vec3::ZERO, Vec3::splat(60.0)), 2.2);
+        for kind in IndexKind::ALL {
+            let mut index = kind.build::<u32>(&hint).unwrap();
+            fill(&mut index);
+            let mut hs = Vec::new();
+            index.for_each(&mut |h, _, _| hs.push(h));
+            for (i, h) in hs.iter().enumerate() {
+                index
+                    .set_filter(*h, Filter::new(1 << (i % 3), 0b011))
+                    .unwrap();
+            }
+            for filter in [None, Some(Filter::new(0b100, 0b001))] {
+                let batch = pool.install(|| par_nearest(&index, &qs, filter)).unwrap();
+                assert_eq!(batch.len(), qs.len());
+                let mut total = 0;
+                for (i, q) in qs.iter().enumerate() {
+                    let mut one = Vec::new();
+                    index.nearest_into(q, filter, &mut one).unwrap();
+                    assert_eq!(batch.get(i), &one[..], "{kind:?} query {i}");
+                    total += one.len();
+                }
+                assert!(total > qs.len(), "{kind:?}: the batch must find things");
+            }
+            let mut bad = qs.clone();
+            bad[7].point.x = f32::NAN;
+            assert!(par_nearest(&index, &bad, None).is_err());
+        }
+    }
+
     #[test]
     fn a_bad_query_fails_the_batch_before_any_work() {
         let mut kd = LooseKdTree::with_config(LooseKdConfig {
@@ -261,8 +401,15 @@ mod tests {
         let bad = Err(Error::NonFinite {
             what: "sphere radius",
         });
-        assert_eq!(par_query_counts(&kd, &qs), bad);
-        let r = par_visit_batch(&kd, &qs, || 0, |n, _, _, _, _: &u32| n + 1, |a, b| a + b);
+        assert_eq!(par_query_counts(&kd, &qs, None), bad);
+        let r = par_visit_batch(
+            &kd,
+            &qs,
+            None,
+            || 0,
+            |n, _, _, _, _: &u32| n + 1,
+            |a, b| a + b,
+        );
         assert_eq!(r, bad.map(|_: Vec<usize>| 0));
     }
 }

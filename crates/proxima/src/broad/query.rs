@@ -2,7 +2,7 @@
 //! the object-safe [`SpatialIndex::visit`](super::SpatialIndex::visit) takes any
 //! of them and each index still runs a walk compiled for the shape.
 
-use crate::geom::{Aabb, Frustum, Ray, Sphere};
+use crate::geom::{Aabb, Frustum, Ray, Sphere, SphereSweep};
 use crate::Result;
 
 /// A region to find stored spheres in. Overlap is closed everywhere: touching
@@ -24,6 +24,13 @@ pub enum Query {
     Ray(Ray),
     /// Spheres not entirely outside any plane of the frustum (culling).
     Frustum(Frustum),
+    /// Spheres the moving sphere touches on its way (continuous collision):
+    /// distance from the centre to the segment `<= r + R`, decided exactly by
+    /// [`overlap::sweep_sphere`](crate::geom::overlap::sweep_sphere). The
+    /// first one and the times of impact:
+    /// [`SpatialIndex::sweep_first`](super::SpatialIndex::sweep_first),
+    /// [`SpatialIndexExt::sweep_hits`](super::SpatialIndexExt::sweep_hits).
+    Sweep(SphereSweep),
 }
 
 impl Query {
@@ -35,6 +42,7 @@ impl Query {
             Query::Aabb(b) => b.validate(),
             Query::Ray(r) => r.validate(),
             Query::Frustum(f) => f.validate(),
+            Query::Sweep(s) => s.validate(),
         }
     }
 }
@@ -60,5 +68,11 @@ impl From<Ray> for Query {
 impl From<Frustum> for Query {
     fn from(f: Frustum) -> Self {
         Query::Frustum(f)
+    }
+}
+
+impl From<SphereSweep> for Query {
+    fn from(s: SphereSweep) -> Self {
+        Query::Sweep(s)
     }
 }

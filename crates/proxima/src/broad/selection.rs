@@ -3,7 +3,7 @@
 //! [`Selection::selects`], so one traversal serves every query shape. Internal:
 //! users query with [`Query`](super::Query); the trait is sealed and hidden.
 
-use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
+use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere, SphereSweep};
 use crate::Result;
 
 pub(crate) mod sealed {
@@ -14,6 +14,7 @@ pub(crate) mod sealed {
     impl Sealed for crate::geom::Aabb {}
     impl Sealed for crate::geom::Ray {}
     impl Sealed for crate::geom::Frustum {}
+    impl Sealed for crate::geom::SphereSweep {}
 }
 
 /// A query over stored spheres, as the index walks see it.
@@ -206,6 +207,33 @@ impl Selection for Ray {
     }
     fn as_ray(&self) -> Option<&Ray> {
         Some(self)
+    }
+}
+
+/// A sweep selects what it touches ([`overlap::sweep_sphere`], exact); boxes
+/// are tested with [`overlap::sweep_aabb`], conservative and monotone, so a
+/// box holding a touched sphere is never `Outside`. No `Inside` answers: the
+/// segment walks of the grids (`as_ray`) do not apply to a sweep's thickness,
+/// so the grids use its bounding box.
+impl Selection for SphereSweep {
+    fn validate(&self) -> Result<()> {
+        SphereSweep::validate(self)
+    }
+    #[inline]
+    fn selects(&self, s: &Sphere) -> bool {
+        overlap::sweep_sphere(self, s).is_some()
+    }
+    #[inline]
+    fn classify_box(&self, b: &Aabb, mask: u8) -> (Relation, u8) {
+        if overlap::sweep_aabb(self, b).is_some() {
+            (Relation::Intersecting, mask)
+        } else {
+            (Relation::Outside, mask)
+        }
+    }
+    /// The swept volume's box, rounded outward.
+    fn bounds(&self) -> Option<Aabb> {
+        Some(self.aabb())
     }
 }
 

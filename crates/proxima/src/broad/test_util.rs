@@ -32,6 +32,9 @@ pub(crate) fn check_ray(index: &impl SpatialIndex<u32>, brute: &BruteForce<u32>,
         ids(brute.ray_hits(r).unwrap(), brute),
         "{r:?}"
     );
-    let (fi, fb) = (index.ray_first(r).unwrap(), brute.ray_first(r).unwrap());
+    let (fi, fb) = (
+        index.ray_first(r, None).unwrap(),
+        brute.ray_first(r, None).unwrap(),
+    );
     assert_eq!(fi.map(|h| h.t), fb.map(|h| h.t), "{r:?}");
 }

@@ -3,11 +3,17 @@
 //! Each index implements [`Walk`] with its traversals generic over the query
 //! shape and the callback, so every shape gets its own compiled loop. The
 //! public [`SpatialIndex`](super::SpatialIndex) methods reach them through
-//! [`visit`] (one `match` on the [`Query`] per call); [`AnyIndex`](super::AnyIndex)
-//! calls them directly with the caller's closure.
+//! [`visit`] (one `match` on the [`Query`] per call) and [`walk_methods`];
+//! [`AnyIndex`](super::AnyIndex) calls them directly with the caller's closure.
+//!
+//! The searches that are not a plain selection (first ray hit, first sweep
+//! hit, k nearest) and the query filter have correct default implementations
+//! here, written once on top of [`Walk::walk`]; an index overrides them with
+//! its own traversal (front-to-back, best-first, pruning by filter bits).
 
-use super::{Query, RayHit, Selection};
-use crate::geom::{overlap, Ray, Sphere};
+use super::nearest::{self, Nearest, Neighbor};
+use super::{Filter, Query, RayHit, Selection};
+use crate::geom::{overlap, Aabb, Ray, Sphere, SphereSweep};
 use crate::{Handle, Result};
 use std::ops::ControlFlow;
 
@@ -21,25 +27,123 @@ pub(crate) trait Walk<T> {
         f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()>;
 
-    /// Reports every overlapping pair once. Stops when `f` breaks.
+    /// Reports every overlapping pair whose stored filters interact, once.
+    /// Stops when `f` breaks.
     fn walk_pairs(
         &self,
         f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()>;
 
-    /// The hit with the smallest entry `t` (ties: smallest handle), without
-    /// validating the ray. The default scans every hit; indices with a
-    /// hierarchy override it with a front-to-back search.
-    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
-        let mut best: Option<RayHit> = None;
-        let _ = self.walk(ray, |h, s, _| {
-            if let Some(t) = overlap::ray_sphere(ray, s) {
-                RayHit::offer(&mut best, t, h);
-            }
-            ControlFlow::Continue(())
-        });
-        best
+    /// The filter stored with the live object `h` (callers pass handles the
+    /// walks reported, so a stale one is a bug).
+    fn filter_of(&self, h: Handle) -> Filter;
+
+    /// Number of stored objects.
+    fn object_count(&self) -> usize;
+
+    /// [`Walk::walk`] reporting only objects whose filter interacts with
+    /// `filter` (all of them for `None`). The default tests each selected
+    /// object's filter ([`Walk::filter_of`]); an index may prune inside its
+    /// traversal instead.
+    #[inline]
+    fn walk_filtered<Q: Selection + ?Sized>(
+        &self,
+        query: &Q,
+        filter: Option<Filter>,
+        mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        match filter {
+            None => self.walk(query, f),
+            Some(q) => self.walk(query, |h, s, v| {
+                if q.interacts(self.filter_of(h)) {
+                    f(h, s, v)
+                } else {
+                    ControlFlow::Continue(())
+                }
+            }),
+        }
     }
+
+    /// The hit with the smallest entry `t` (ties: smallest handle) among the
+    /// objects `filter` admits, without validating the ray. The default scans
+    /// every hit; indices with a hierarchy override it with a front-to-back
+    /// search.
+    fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
+        scan_first(self, ray, filter)
+    }
+
+    /// The object the sweep touches first: smallest time of impact
+    /// ([`overlap::sweep_sphere`]), ties by the smaller handle, among the
+    /// objects `filter` admits; without validating the sweep. The default scans
+    /// every touched object (the index's walk for [`Query::Sweep`]); indices
+    /// with a hierarchy search front to back, pruning by
+    /// [`overlap::sweep_aabb`]'s entry bound.
+    fn first_sweep_hit(&self, sweep: &SphereSweep, filter: Option<Filter>) -> Option<RayHit> {
+        scan_first(self, sweep, filter)
+    }
+
+    /// The answer of a k-nearest query into `out` (cleared first), nearest
+    /// first, without validating the query. The default is the expanding
+    /// sphere search of `nearest.rs`; indices override it with best-first or
+    /// ring searches.
+    fn knn_into(&self, query: &Nearest, filter: Option<Filter>, out: &mut Vec<Neighbor>) {
+        nearest::expanding(self, query, filter, out)
+    }
+}
+
+/// A ray or a sphere sweep, as the first-hit searches see it: a selection
+/// with a parameter of first contact. Written once here so that every index
+/// answers `ray_first` and `sweep_first` with one search each.
+pub(crate) trait Cast: Selection {
+    /// The parameter at which the cast first touches the closed sphere `s`,
+    /// or `None` ([`overlap::ray_sphere`], [`overlap::sweep_sphere`]).
+    fn contact(&self, s: &Sphere) -> Option<f32>;
+    /// A lower bound on [`Cast::contact`] of every sphere inside `b`, or `None`
+    /// when the cast touches nothing inside it ([`overlap::ray_aabb`],
+    /// [`overlap::sweep_aabb`]); monotone in the box, so front-to-back searches
+    /// may skip a box entered after the best contact so far.
+    fn enter(&self, b: &Aabb) -> Option<f32>;
+}
+
+impl Cast for Ray {
+    #[inline]
+    fn contact(&self, s: &Sphere) -> Option<f32> {
+        overlap::ray_sphere(self, s)
+    }
+    #[inline]
+    fn enter(&self, b: &Aabb) -> Option<f32> {
+        overlap::ray_aabb(self, b).map(|(t0, _)| t0)
+    }
+}
+
+impl Cast for SphereSweep {
+    #[inline]
+    fn contact(&self, s: &Sphere) -> Option<f32> {
+        overlap::sweep_sphere(self, s)
+    }
+    #[inline]
+    fn enter(&self, b: &Aabb) -> Option<f32> {
+        overlap::sweep_aabb(self, b).map(|(t0, _)| t0)
+    }
+}
+
+/// The first contact of a ray or sweep by a scan of everything the index's
+/// walk selects (the default of [`Walk::first_hit`] and
+/// [`Walk::first_sweep_hit`], also the fallback of overrides that do not
+/// handle a query filter).
+pub(crate) fn scan_first<T, I: Walk<T> + ?Sized, C: Cast>(
+    index: &I,
+    cast: &C,
+    filter: Option<Filter>,
+) -> Option<RayHit> {
+    let mut best: Option<RayHit> = None;
+    let _ = index.walk_filtered(cast, filter, |h, s, _| {
+        if let Some(t) = cast.contact(s) {
+            RayHit::offer(&mut best, t, h);
+        }
+        ControlFlow::Continue(())
+    });
+    best
 }
 
 /// Validates `query`, then runs the index's walk for its shape: the one match
@@ -48,14 +152,16 @@ pub(crate) trait Walk<T> {
 pub(crate) fn visit<T, I: Walk<T> + ?Sized>(
     index: &I,
     query: &Query,
+    filter: Option<Filter>,
     f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
 ) -> Result<ControlFlow<()>> {
     query.validate()?;
     Ok(match query {
-        Query::Sphere(s) => index.walk(s, f),
-        Query::Aabb(b) => index.walk(b, f),
-        Query::Ray(r) => index.walk(r, f),
-        Query::Frustum(fr) => index.walk(fr, f),
+        Query::Sphere(s) => index.walk_filtered(s, filter, f),
+        Query::Aabb(b) => index.walk_filtered(b, filter, f),
+        Query::Ray(r) => index.walk_filtered(r, filter, f),
+        Query::Frustum(fr) => index.walk_filtered(fr, filter, f),
+        Query::Sweep(sw) => index.walk_filtered(sw, filter, f),
     })
 }
 
@@ -66,13 +172,14 @@ macro_rules! walk_methods {
         fn visit(
             &self,
             query: &$crate::broad::Query,
+            filter: Option<$crate::broad::Filter>,
             f: &mut dyn FnMut(
                 $crate::Handle,
                 &$crate::geom::Sphere,
                 &$t,
             ) -> std::ops::ControlFlow<()>,
         ) -> $crate::Result<std::ops::ControlFlow<()>> {
-            $crate::broad::walk::visit(self, query, f)
+            $crate::broad::walk::visit(self, query, filter, f)
         }
 
         fn visit_pairs(
@@ -90,9 +197,33 @@ macro_rules! walk_methods {
         fn ray_first(
             &self,
             ray: &$crate::geom::Ray,
+            filter: Option<$crate::broad::Filter>,
         ) -> $crate::Result<Option<$crate::broad::RayHit>> {
             ray.validate()?;
-            Ok($crate::broad::walk::Walk::first_hit(self, ray))
+            Ok($crate::broad::walk::Walk::first_hit(self, ray, filter))
+        }
+
+        fn sweep_first(
+            &self,
+            sweep: &$crate::geom::SphereSweep,
+            filter: Option<$crate::broad::Filter>,
+        ) -> $crate::Result<Option<$crate::broad::SweepHit>> {
+            sweep.validate()?;
+            Ok($crate::broad::walk::Walk::first_sweep_hit(
+                self, sweep, filter,
+            ))
+        }
+
+        fn nearest_into(
+            &self,
+            query: &$crate::broad::Nearest,
+            filter: Option<$crate::broad::Filter>,
+            out: &mut Vec<$crate::broad::Neighbor>,
+        ) -> $crate::Result<()> {
+            out.clear();
+            query.validate()?;
+            $crate::broad::walk::Walk::knn_into(self, query, filter, out);
+            Ok(())
         }
     };
 }

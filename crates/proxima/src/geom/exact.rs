@@ -60,18 +60,34 @@ fn add_square(e: &mut Vec<f64>, sign: f64, u: f64, v: f64) {
 
 /// Exactly: `|a - b| <= r1 + r2` for `f32` values given as `f64`.
 pub(crate) fn within(a: [f64; 3], b: [f64; 3], r1: f64, r2: f64) -> bool {
-    let mut e = Vec::with_capacity(32);
+    cmp_distance(a, b, r1, r2) != std::cmp::Ordering::Greater
+}
+
+/// Exactly: the sign of `|a - b| - (r1 + r2)`, for coordinates that are `f32`s
+/// given as `f64` and `r1`, `r2` `f64`s of about the `f32` range (an `f32`, or
+/// the midpoint of two neighbouring `f32`s), so that no product below overflows
+/// or underflows and each is exact. A negative sum `r1 + r2` is handled too
+/// (then the distance is larger).
+pub(crate) fn cmp_distance(a: [f64; 3], b: [f64; 3], r1: f64, r2: f64) -> std::cmp::Ordering {
+    use std::cmp::Ordering;
     let (rs, re) = two_sum(r1, r2);
-    add_square(&mut e, 1.0, rs, re);
+    // `rs + re` is exact, so its sign is that of `rs` (`re == 0` when `rs == 0`).
+    if rs < 0.0 {
+        return Ordering::Greater;
+    }
+    // Both sides are non-negative: compare their squares.
+    let mut e = Vec::with_capacity(32);
+    add_square(&mut e, -1.0, rs, re);
     for i in 0..3 {
         let (ds, de) = two_sum(a[i], -b[i]);
-        add_square(&mut e, -1.0, ds, de);
+        add_square(&mut e, 1.0, ds, de);
     }
     // The largest nonzero component carries the sign.
-    e.iter()
-        .rev()
-        .find(|&&x| x != 0.0)
-        .map_or(true, |&x| x > 0.0)
+    match e.iter().rev().find(|&&x| x != 0.0) {
+        Some(&x) if x > 0.0 => Ordering::Greater,
+        Some(_) => Ordering::Less,
+        None => Ordering::Equal,
+    }
 }
 
 /// An exact real number as a nonoverlapping expansion: the sum of its `f64`

@@ -1,4 +1,6 @@
-//! Geometric primitives and the closed overlap tests between them.
+//! Geometric primitives ([`Sphere`], [`Aabb`], [`Ray`], [`Segment`],
+//! [`SphereSweep`], [`Plane`], [`Frustum`]) and the closed overlap tests and
+//! distances between them.
 //!
 //! Every test lives once, in [`overlap`], named by the shape pair; the indices call
 //! these functions and never re-implement them. "Closed" means touching counts:
@@ -7,13 +9,16 @@
 mod aabb;
 pub(crate) mod exact;
 mod frustum;
+mod line_ball;
 pub mod overlap;
 mod plane;
 mod ray;
 mod sphere;
+mod sweep;
 
 pub use aabb::Aabb;
 pub use frustum::{Frustum, Relation};
 pub use plane::Plane;
 pub use ray::{Ray, Segment};
 pub use sphere::Sphere;
+pub use sweep::SphereSweep;

@@ -1,10 +1,19 @@
-//! The closed overlap tests, one function per shape pair. Every index and every
-//! method on the shape types calls these; nothing re-implements them.
+//! The closed overlap tests, one function per shape pair, and the distances of
+//! the k-nearest queries. Every index and every method on the shape types calls
+//! these; nothing re-implements them.
 //!
 //! Closed means boundaries count: touching shapes overlap. Costs are O(1).
+//!
+//! | shapes | test | box test the index walks prune with |
+//! |---|---|---|
+//! | sphere–sphere, sphere–box | [`sphere_sphere`], [`sphere_aabb`] | [`sphere_aabb`] |
+//! | ray/segment–sphere (first `t`) | [`ray_sphere`] | [`ray_aabb`] |
+//! | sphere sweep–sphere (time of impact) | [`sweep_sphere`] | [`sweep_aabb`] |
+//! | frustum–sphere | [`frustum_sphere`] | [`frustum_aabb`] |
+//! | point–sphere distance (k nearest) | [`point_sphere_distance`] | [`point_aabb_distance`] |
 
 use crate::geom::exact::Exp;
-use crate::geom::{Aabb, Frustum, Ray, Relation, Sphere};
+use crate::geom::{Aabb, Frustum, Ray, Relation, Sphere, SphereSweep};
 use glam::{Vec3, Vec4};
 use std::cmp::Ordering;
 
@@ -13,9 +22,11 @@ use std::cmp::Ordering;
 // evaluation decides unless the two sides agree to 1e-12 relative; then an exact
 // evaluation (error-free transformations, see `exact.rs`) decides. In `f64` no
 // square of a finite `f32` overflows (x² <= 1.2e77), so there is no `inf <= inf`.
-// The ray and frustum tests are exact too (hit/miss, cull/keep), by the same
-// filter-then-expansion scheme; only the returned ray parameters are rounded,
-// and those outward where pruning depends on them.
+// The ray, sweep and frustum tests are exact too (hit/miss, cull/keep), by the
+// same filter-then-expansion scheme (rays and sweeps share one implementation,
+// `line_ball.rs`); only the returned parameters are rounded, and those
+// consistently with the box tests where pruning depends on them. Distances are
+// correctly rounded, so they are monotone and the same in every index.
 
 #[inline]
 fn d3(v: Vec3) -> [f64; 3] {
@@ -148,49 +159,7 @@ pub fn aabb_aabb(a: &Aabb, b: &Aabb) -> bool {
     a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
 }
 
-/// Relative error bound for the `f64` filters of the ray and frustum tests: every
-/// filtered quantity is a polynomial of degree <= 4 in `f32` inputs, evaluated
-/// with a handful of roundings of 2^-53 each, whose error is below ~16 · 2^-53 of
-/// its permanent (the same polynomial on absolute values). 1e-14 is 9× that.
-const FILTER: f64 = 1e-14;
-
-/// The sign of a value computed in `f64` as `v` with permanent `perm`, if the
-/// filter decides it; `None` sends the caller to the exact evaluation.
-#[inline]
-fn filtered(v: f64, perm: f64) -> Option<Ordering> {
-    let margin = FILTER * perm;
-    if v > margin {
-        Some(Ordering::Greater)
-    } else if v < -margin {
-        Some(Ordering::Less)
-    } else {
-        None
-    }
-}
-
-/// The unit roundoff of `f64`, 2^-53.
-const U: f64 = f64::EPSILON / 2.0;
-
-/// The sign of `lhs - |v|²`, if an `f64` evaluation decides it: `lhs` within
-/// 4u of its value (a product of up to three rounded factors), each `v[k]`
-/// within `err[k]` of its value. An a-posteriori bound (from the computed `v`,
-/// not from the inputs' magnitudes), so a long ray passing near a small sphere
-/// (huge inputs, modest cross product) still decides in `f64`; the bound is
-/// doubled to cover its own rounding.
-#[inline]
-fn square_gap(lhs: f64, v: [f64; 3], err: [f64; 3]) -> Option<Ordering> {
-    let vv = dot(v, v);
-    let mut bound = 4.0 * U * (lhs + vv);
-    for k in 0..3 {
-        bound += (2.0 * v[k].abs() + err[k]) * err[k];
-    }
-    filtered(lhs - vv, 2.0 * bound / FILTER)
-}
-
-#[inline]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
+use super::line_ball::{dot, filtered, first_touch, Exact, Line, U};
 
 /// Ray (or segment) against a sphere: a parameter `t` in `[0, ray.max_t]` at which
 /// the ray is (up to rounding) entering the closed ball, or `None` when no point
@@ -203,7 +172,8 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// within `max_t` and `|m × d|² <= r²|d|²`, or it lies beyond and the end point is
 /// in the ball (`|m + max_t d|² <= r²`). Each sign is first taken from an `f64`
 /// evaluation with an error bound (cost: ~40 flops) and only for near-ties
-/// from error-free expansions (`exact.rs`).
+/// from error-free expansions (`exact.rs`). The scheme is written once, for
+/// rays and [`sweep_sphere`] alike (`line_ball.rs`).
 ///
 /// The returned `t` is the closest-approach formula in `f64` (no `b² - ac`
 /// cancellation), rounded to `f32`, then clamped into `[lb, max_t]` where `lb` is
@@ -213,30 +183,45 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// (`box t0 > best t`) never drops a nearer hit.
 #[inline]
 pub fn ray_sphere(ray: &Ray, s: &Sphere) -> Option<f32> {
-    if within(ray.origin, s.center, s.radius, 0.0) {
-        return Some(0.0);
+    first_touch(&RayBall { ray, s })
+}
+
+/// A ray and a stored sphere, as the shared line–ball test sees them.
+struct RayBall<'a> {
+    ray: &'a Ray,
+    s: &'a Sphere,
+}
+
+impl Line for RayBall<'_> {
+    #[inline]
+    fn starts_inside(&self) -> bool {
+        within(self.ray.origin, self.s.center, self.s.radius, 0.0)
     }
-    let (o, c, d) = (d3(ray.origin), d3(s.center), d3(ray.dir));
-    let m = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
-    let r = s.radius as f64;
-    let (b, b_perm) = (dot(m, d), dot(m.map(f64::abs), d.map(f64::abs)));
-    let approaching = filtered(b, b_perm).unwrap_or_else(|| ray_exact::m_dot_d(ray, s));
-    if approaching != Ordering::Less {
-        // Outside and not approaching: the distance only grows with t.
-        return None;
+    #[inline]
+    fn m_d(&self) -> ([f64; 3], [f64; 3]) {
+        let (o, c) = (d3(self.ray.origin), d3(self.s.center));
+        ([0, 1, 2].map(|i| o[i] - c[i]), d3(self.ray.dir))
     }
-    let a = dot(d, d);
-    let big_t = ray.max_t as f64;
-    // Closest approach `t* = -b / a` within `max_t`: sign of `max_t·a + b`.
-    let closest_within = big_t.is_infinite()
-        || filtered(big_t * a + b, big_t * a + b_perm)
-            .unwrap_or_else(|| ray_exact::end_minus_closest(ray, s))
-            != Ordering::Less;
-    let hit = if closest_within {
-        // r²|d|² - |m × d|² >= 0, with m × d = o × d - c × d: the products of
-        // `f32`s are exact in `f64`, so each component rounds only three times,
-        // relative to values that do not include the huge cancelling parts of
-        // `m` (a ray from 1e20 passing 100 units from a sphere still decides).
+    #[inline]
+    fn t_max(&self) -> f32 {
+        self.ray.max_t
+    }
+    #[inline]
+    fn rho2(&self) -> f64 {
+        let r = self.s.radius as f64;
+        r * r
+    }
+    /// `r²` is exact and `|d|²` rounds twice: within the 4u always allowed.
+    #[inline]
+    fn lhs_units(&self) -> f64 {
+        0.0
+    }
+    /// `m × d = o × d - c × d`: the products of `f32`s are exact in `f64`, so
+    /// each component rounds only three times, relative to values that do not
+    /// include the huge cancelling parts of `m` (a ray from 1e20 passing 100
+    /// units from a sphere still decides).
+    #[inline]
+    fn cross(&self, _m: [f64; 3], d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
         let cross = |p: [f64; 3]| {
             [
                 p[1] * d[2] - p[2] * d[1],
@@ -244,111 +229,325 @@ pub fn ray_sphere(ray: &Ray, s: &Sphere) -> Option<f32> {
                 p[0] * d[1] - p[1] * d[0],
             ]
         };
-        let (ox, cx) = (cross(o), cross(c));
+        let (ox, cx) = (cross(d3(self.ray.origin)), cross(d3(self.s.center)));
         let cr = [0, 1, 2].map(|k| ox[k] - cx[k]);
         let err = [0, 1, 2].map(|k| 2.0 * U * (ox[k].abs() + cx[k].abs() + cr[k].abs()));
-        square_gap(r * r * a, cr, err).unwrap_or_else(|| ray_exact::line_gap(ray, s))
-            != Ordering::Less
-    } else {
-        // r² - |o + max_t d - c|² >= 0 (`max_t d` is exact: two `f32`s), two
-        // roundings per component, bounded by the computed values.
+        (cr, err)
+    }
+    /// `o + max_t d - c` (`max_t d` is exact: two `f32`s), two roundings per
+    /// component.
+    #[inline]
+    fn end(&self, _m: [f64; 3], d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let (o, c) = (d3(self.ray.origin), d3(self.s.center));
+        let big_t = self.ray.max_t as f64;
         let e = [0, 1, 2].map(|i| o[i] + big_t * d[i]);
         let p = [0, 1, 2].map(|i| e[i] - c[i]);
         let err = [0, 1, 2].map(|i| 2.0 * U * (e[i].abs() + p[i].abs()));
-        square_gap(r * r, p, err).unwrap_or_else(|| ray_exact::end_gap(ray, s)) != Ordering::Less
-    };
-    if !hit {
-        return None;
+        (p, err)
     }
-    let tc = -b / a;
-    let closest = [m[0] + d[0] * tc, m[1] + d[1] * tc, m[2] + d[2] * tc];
-    let h2 = (r * r - dot(closest, closest)).max(0.0);
-    let t = (tc - (h2 / a).sqrt()).max(0.0) as f32;
-    // The sphere's bounding box, rounded outward to `f32`: every index box that
-    // contains the sphere contains it.
-    let lb = ray_aabb(ray, &outward_box(s)).map_or(0.0, |(t0, _)| t0);
-    Some(t.max(lb).min(ray.max_t))
+    fn exact(&self) -> Exact {
+        let (o, c) = (d3(self.ray.origin), d3(self.s.center));
+        let t = self.ray.max_t;
+        Exact {
+            m: [0, 1, 2].map(|i| Exp::diff(o[i], c[i])),
+            d: d3(self.ray.dir).map(Exp::of),
+            rho: Exp::of(self.s.radius as f64),
+            t: t.is_finite().then(|| Exp::of(t as f64)),
+        }
+    }
+    /// The sphere's bounding box, rounded outward to `f32`: every index box that
+    /// contains the sphere contains it.
+    #[inline]
+    fn entry_floor(&self) -> f32 {
+        ray_aabb(self.ray, &outward_box(self.s)).map_or(0.0, |(t0, _)| t0)
+    }
+}
+
+/// Sphere sweep against a stored sphere: the time `t` in `[0, 1]` at which the
+/// sweep's sphere, moving from `sweep.from` to `sweep.to`, first touches the
+/// closed ball `s` (`0` when they touch at the start), or `None` when it never
+/// does — when the distance from `s.center` to the segment exceeds
+/// `s.radius + sweep.radius`.
+///
+/// Touching or not is decided **exactly** for the real numbers the `f32`
+/// inputs denote: the segment is taken from its end points (its direction
+/// `to - from` is never rounded to `f32`) and the radius is the exact sum
+/// `r + R`. The scheme is [`ray_sphere`]'s, written once (`line_ball.rs`).
+/// With `radius == 0` this is the exact segment test: it equals `ray_sphere`
+/// on [`Segment::to_ray`](crate::geom::Segment::to_ray) whenever `to - from` is
+/// an `f32` (otherwise `to_ray` rounds the segment and this does not). A
+/// zero-length sweep touches iff it starts touching.
+///
+/// The returned `t` is rounded (closest-approach formula in `f64`), then
+/// clamped into `[lb, 1]` where `lb` is [`sweep_aabb`]'s entry bound for the
+/// sphere's bounding box rounded outward: every index box containing the
+/// sphere enters no later (the box test is monotone), so front-to-back pruning
+/// by box entry never drops an earlier hit. Cost: ~50 flops, expansions only
+/// for near-ties.
+#[inline]
+pub fn sweep_sphere(sweep: &SphereSweep, s: &Sphere) -> Option<f32> {
+    first_touch(&SweepBall { sweep, s })
+}
+
+/// A sphere sweep and a stored sphere, as the shared line–ball test sees them.
+struct SweepBall<'a> {
+    sweep: &'a SphereSweep,
+    s: &'a Sphere,
+}
+
+impl Line for SweepBall<'_> {
+    #[inline]
+    fn starts_inside(&self) -> bool {
+        within(
+            self.sweep.from,
+            self.s.center,
+            self.s.radius,
+            self.sweep.radius,
+        )
+    }
+    #[inline]
+    fn m_d(&self) -> ([f64; 3], [f64; 3]) {
+        let (f, t, c) = (d3(self.sweep.from), d3(self.sweep.to), d3(self.s.center));
+        (
+            [0, 1, 2].map(|i| f[i] - c[i]),
+            [0, 1, 2].map(|i| t[i] - f[i]),
+        )
+    }
+    #[inline]
+    fn t_max(&self) -> f32 {
+        1.0
+    }
+    #[inline]
+    fn rho2(&self) -> f64 {
+        let rho = self.s.radius as f64 + self.sweep.radius as f64;
+        rho * rho
+    }
+    /// `ρ = r + R` rounds once, `ρ²` once more (3u); each `d_i` carries u, so
+    /// `|d|²` about 5u; the product one more: below 12u beyond the 4u.
+    #[inline]
+    fn lhs_units(&self) -> f64 {
+        12.0
+    }
+    /// `m × d = (from - c) × (to - c)` (the `(from - c) × (from - c)` part is
+    /// zero): both differences round once, each product once more and the
+    /// difference of products once.
+    #[inline]
+    fn cross(&self, m: [f64; 3], _d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let (t, c) = (d3(self.sweep.to), d3(self.s.center));
+        let n = [0, 1, 2].map(|i| t[i] - c[i]);
+        let mut cr = [0.0; 3];
+        let mut err = [0.0; 3];
+        for k in 0..3 {
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            let (p, q) = (m[i] * n[j], m[j] * n[i]);
+            cr[k] = p - q;
+            err[k] = 4.0 * U * (p.abs() + q.abs() + cr[k].abs());
+        }
+        (cr, err)
+    }
+    /// `to - c`, one rounding per component.
+    #[inline]
+    fn end(&self, _m: [f64; 3], _d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let (t, c) = (d3(self.sweep.to), d3(self.s.center));
+        let p = [0, 1, 2].map(|i| t[i] - c[i]);
+        (p, p.map(|x| 2.0 * U * x.abs()))
+    }
+    fn exact(&self) -> Exact {
+        let (f, t, c) = (d3(self.sweep.from), d3(self.sweep.to), d3(self.s.center));
+        Exact {
+            m: [0, 1, 2].map(|i| Exp::diff(f[i], c[i])),
+            d: [0, 1, 2].map(|i| Exp::diff(t[i], f[i])),
+            rho: Exp::diff(self.s.radius as f64, -(self.sweep.radius as f64)),
+            t: Some(Exp::of(1.0)),
+        }
+    }
+    #[inline]
+    fn entry_floor(&self) -> f32 {
+        sweep_aabb(self.sweep, &outward_box(self.s)).map_or(0.0, |(t0, _)| t0)
+    }
+}
+
+/// Sphere sweep against a box: a parameter interval `[t0, t1]` within `[0, 1]`
+/// that contains every time at which the sweep's sphere touches the closed box
+/// `b` (its centre `from + t (to - from)` within `sweep.radius` of `b`), or
+/// `None` only when it never does. Conservative, never exact: the index walks
+/// prune with it, and [`sweep_sphere`] is the exact test.
+///
+/// It is [`ray_aabb`] for the ray from `from` along `to - from` rounded to `f32`
+/// (`max_t = 1`), against `b` grown on each axis by `R` plus a bound on what
+/// that rounding moved the segment, everything rounded outward. So `t0` is
+/// monotone in the box (a larger box never enters later) and never above the
+/// time [`sweep_sphere`] returns for a sphere inside `b`. With `radius == 0`
+/// and an `f32` direction it is exactly `ray_aabb` of the segment. A sweep
+/// whose direction overflows `f32` (end points near `±f32::MAX` on opposite
+/// sides) prunes nothing: `Some((0, 1))`. Cost: [`ray_aabb`]'s plus a few
+/// exact sums.
+#[inline]
+pub fn sweep_aabb(sweep: &SphereSweep, b: &Aabb) -> Option<(f32, f32)> {
+    let (from, to) = (d3(sweep.from), d3(sweep.to));
+    let mut dir = [0.0f32; 3];
+    let mut lo = [0.0f32; 3];
+    let mut hi = [0.0f32; 3];
+    for i in 0..3 {
+        // The exact direction `s + e`, its `f32` rounding, and what the
+        // rounding moves the segment by at most (at t = 1).
+        let (s, e) = super::exact::two_sum_pub(to[i], -from[i]);
+        let d = s as f32;
+        if !d.is_finite() {
+            return Some((0.0, 1.0));
+        }
+        dir[i] = d;
+        let moved = (s - d as f64).abs() + e.abs();
+        let grow = if moved == 0.0 {
+            sweep.radius as f64
+        } else {
+            // Rounded up: at least R + moved.
+            let g = sweep.radius as f64 + moved;
+            g + g * (4.0 * U)
+        };
+        lo[i] = sum_floor(b.min[i], -grow);
+        hi[i] = -sum_floor(-b.max[i], -grow);
+    }
+    let ray = Ray::with_max_t(sweep.from, Vec3::from(dir), 1.0);
+    ray_aabb(&ray, &Aabb::new(Vec3::from(lo), Vec3::from(hi)))
+}
+
+/// The largest `f32` not above `x + g` (exactly; `x` passes through when it
+/// is not finite).
+#[inline]
+pub(super) fn sum_floor(x: f32, g: f64) -> f32 {
+    if !x.is_finite() {
+        return x;
+    }
+    let (v, e) = super::exact::two_sum_pub(x as f64, g);
+    // `round_down(v)` is at least one `f64` step below `v` unless `v` is an
+    // `f32`; only then can the error `e` push the true value below it.
+    if e < 0.0 && (v as f32) as f64 == v {
+        step_down(v as f32)
+    } else {
+        round_down(v)
+    }
 }
 
 /// The smallest `f32` box containing the ball exactly.
 #[inline]
 fn outward_box(s: &Sphere) -> Aabb {
     let r = s.radius as f64;
-    let c = d3(s.center);
-    let lo = [0, 1, 2].map(|i| {
-        let (v, e) = super::exact::two_sum_pub(c[i], -r);
-        // `round_down(v)` is at least one `f64` step below `v` unless `v` is an
-        // `f32`; only then can the error `e` push the true value below it.
-        if e < 0.0 && (v as f32) as f64 == v {
-            step_down(v as f32)
-        } else {
-            round_down(v)
-        }
-    });
-    let hi = [0, 1, 2].map(|i| {
-        let (v, e) = super::exact::two_sum_pub(c[i], r);
-        if e > 0.0 && (v as f32) as f64 == v {
-            -step_down(-(v as f32))
-        } else {
-            round_up(v)
-        }
-    });
+    let lo = [0, 1, 2].map(|i| sum_floor(s.center[i], -r));
+    let hi = [0, 1, 2].map(|i| -sum_floor(-s.center[i], -r));
     Aabb::new(Vec3::from(lo), Vec3::from(hi))
 }
 
-/// The exact fallbacks of [`ray_sphere`], one per filtered sign.
-mod ray_exact {
-    use super::d3;
-    use crate::geom::exact::Exp;
-    use crate::geom::{Ray, Sphere};
-    use std::cmp::Ordering;
-
-    fn parts(ray: &Ray, s: &Sphere) -> ([Exp; 3], [f64; 3]) {
-        let (o, c) = (d3(ray.origin), d3(s.center));
-        ([0, 1, 2].map(|i| Exp::diff(o[i], c[i])), d3(ray.dir))
+/// The distance from `p` to the closed ball `s`, `max(0, |c - p| - r)`
+/// (`0` inside), **correctly rounded** to `f32`: the `f32` nearest to the
+/// exact real value (ties to even).
+///
+/// This is the one distance of the k-nearest queries (with `r = 0` for the
+/// centre distance), so every index reports the same value for the same
+/// object, bit for bit, and orders ties the same way. Correct rounding is what
+/// makes it consistent with the index walks: it is monotone in the exact
+/// distance, so a sphere inside a box is never reported nearer than
+/// [`point_aabb_distance`] of that box, and a sphere query of an `f32` radius
+/// `R` (exact) selects every object whose distance is `<= R`. Its value is
+/// also what a reader expects: equal for equal centres and radii, `0` inside,
+/// exact whenever the exact distance is an `f32`.
+///
+/// Cost: an `f64` evaluation (~15 flops and a square root) decides unless the
+/// exact value lies within ~1e-15 relative of a rounding boundary; then exact
+/// comparisons with the boundary (`exact.rs`) decide. Distances beyond
+/// `f32::MAX` round to `f32::MAX` or `∞` as IEEE rounding says.
+#[inline]
+pub fn point_sphere_distance(p: Vec3, s: &Sphere) -> f32 {
+    let (a, c) = (d3(p), d3(s.center));
+    let diff = [0, 1, 2].map(|i| a[i] - c[i]);
+    let dist = dot(diff, diff).sqrt();
+    let r = s.radius as f64;
+    let v = dist - r;
+    // Each difference rounds once, squares and sums three times, the root
+    // about 1.5 more: `dist` is within 4u of `|a - c|`, and the subtraction adds
+    // u of `|v|` (no underflow: nonzero differences of `f32`s are >= 2^-149).
+    let err = 8.0 * U * (dist + v.abs());
+    if v + err <= 0.0 {
+        return 0.0;
     }
-
-    fn dot(a: &[Exp; 3], b: &[Exp; 3]) -> Exp {
-        a[0].mul(&b[0]).add(&a[1].mul(&b[1])).add(&a[2].mul(&b[2]))
+    let y = (v as f32).max(0.0);
+    if v - err > rounding_below(y) && v + err < rounding_above(y) {
+        return y;
     }
+    distance_rounded_exactly(a, c, r, v, err)
+}
 
-    /// Sign of `m · d`.
-    pub(super) fn m_dot_d(ray: &Ray, s: &Sphere) -> Ordering {
-        let (m, d) = parts(ray, s);
-        dot(&m, &d.map(Exp::of)).sign()
-    }
+/// The midpoint between the non-negative `f32` `y` and the next one up (exact
+/// in `f64`; `2^128` stands for the one above `f32::MAX`): reals below it
+/// round to `y` or lower.
+#[inline]
+fn rounding_above(y: f32) -> f64 {
+    let next = if y == f32::MAX {
+        2f64.powi(128)
+    } else {
+        -step_down(-y) as f64
+    };
+    (y as f64 + next) * 0.5
+}
 
-    /// Sign of `max_t |d|² + m · d`.
-    pub(super) fn end_minus_closest(ray: &Ray, s: &Sphere) -> Ordering {
-        let (m, d) = parts(ray, s);
-        let d = d.map(Exp::of);
-        Exp::of(ray.max_t as f64)
-            .mul(&dot(&d, &d))
-            .add(&dot(&m, &d))
-            .sign()
+/// The midpoint between the non-negative `f32` `y` and the next one down;
+/// `-∞` for `y = 0` (negative values clamp to 0).
+#[inline]
+fn rounding_below(y: f32) -> f64 {
+    if y == 0.0 {
+        f64::NEG_INFINITY
+    } else {
+        (y as f64 + step_down(y) as f64) * 0.5
     }
+}
 
-    /// Sign of `r² |d|² - |m × d|²`.
-    pub(super) fn line_gap(ray: &Ray, s: &Sphere) -> Ordering {
-        let (m, d) = parts(ray, s);
-        let d = d.map(Exp::of);
-        let cr = [
-            m[1].mul(&d[2]).sub(&m[2].mul(&d[1])),
-            m[2].mul(&d[0]).sub(&m[0].mul(&d[2])),
-            m[0].mul(&d[1]).sub(&m[1].mul(&d[0])),
-        ];
-        let r = Exp::of(s.radius as f64);
-        r.mul(&r).mul(&dot(&d, &d)).sub(&dot(&cr, &cr)).sign()
+/// [`point_sphere_distance`] when the `f64` value `v` (within `err` of the
+/// exact `x = |a - c| - r`) does not decide the rounding: a binary search over
+/// the `f32`s between `v - err` and `v + err` (in bit order, which is numeric
+/// order for non-negative floats) for the one `x` rounds to, each step an
+/// exact comparison of `x` with a rounding midpoint (ties to even). At most
+/// ~32 steps; usually 1 or 2 (the interval is a few ulps wide unless `r`
+/// nearly cancels a huge `|a - c|`).
+#[cold]
+#[inline(never)]
+fn distance_rounded_exactly(a: [f64; 3], c: [f64; 3], r: f64, v: f64, err: f64) -> f32 {
+    // round(max(0, x)) <= y, for a non-negative f32 y.
+    let at_most = |y: f32| {
+        if y == f32::INFINITY {
+            return true;
+        }
+        match super::exact::cmp_distance(a, c, r, rounding_above(y)) {
+            Ordering::Less => true,
+            Ordering::Equal => y.to_bits() & 1 == 0,
+            Ordering::Greater => false,
+        }
+    };
+    // round(x) is monotone: it lies between the roundings of x's bounds.
+    let mut lo = if v - err > 0.0 {
+        round_down(v - err).to_bits()
+    } else {
+        0 // +0.0
+    };
+    let mut hi = (-round_down(-(v + err))).to_bits();
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if at_most(f32::from_bits(mid)) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
     }
+    f32::from_bits(lo)
+}
 
-    /// Sign of `r² - |m + max_t d|²`.
-    pub(super) fn end_gap(ray: &Ray, s: &Sphere) -> Ordering {
-        let (m, d) = parts(ray, s);
-        let t = Exp::of(ray.max_t as f64);
-        let p = [0, 1, 2].map(|i| m[i].add(&t.mul(&Exp::of(d[i]))));
-        let r = Exp::of(s.radius as f64);
-        r.mul(&r).sub(&dot(&p, &p)).sign()
-    }
+/// The distance from `p` to the closed box `b` (`0` inside), correctly rounded
+/// to `f32` like [`point_sphere_distance`] (it is that distance to the box's
+/// closest point). The bound the k-nearest searches prune with: for a sphere
+/// inside `b`, neither its surface distance nor its centre distance is below
+/// this (correct rounding is monotone). O(1).
+#[inline]
+pub fn point_aabb_distance(p: Vec3, b: &Aabb) -> f32 {
+    point_sphere_distance(p, &Sphere::new(p.clamp(b.min, b.max), 0.0))
 }
 
 /// Ray (or segment) against a box: the interval `[t0, t1]` of `f32`s that
@@ -403,12 +602,6 @@ pub fn ray_aabb(ray: &Ray, b: &Aabb) -> Option<(f32, f32)> {
 }
 
 use super::exact::{f32_down as step_down, round_down_f32 as round_down};
-
-/// The smallest `f32` not below `x`.
-#[inline]
-fn round_up(x: f64) -> f32 {
-    -round_down(-x)
-}
 
 /// The exact sign of `t[0] + t[1] + t[2] + t[3]` for `f64` terms that are exact
 /// products of `f32`s (or `f32`s), or `None` when it is undefined (a NaN, or
@@ -739,17 +932,8 @@ mod tests {
     /// for its `f64` filters).
     fn ray_sphere_exact_ref(ray: &Ray, s: &Sphere) -> bool {
         let d = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
-        if crate::geom::exact::within(d(ray.origin), d(s.center), s.radius as f64, 0.0) {
-            return true;
-        }
-        if ray_exact::m_dot_d(ray, s) != Ordering::Less {
-            return false;
-        }
-        if ray.max_t.is_infinite() || ray_exact::end_minus_closest(ray, s) != Ordering::Less {
-            ray_exact::line_gap(ray, s) != Ordering::Less
-        } else {
-            ray_exact::end_gap(ray, s) != Ordering::Less
-        }
+        let inside = crate::geom::exact::within(d(ray.origin), d(s.center), s.radius as f64, 0.0);
+        RayBall { ray, s }.exact().touches(inside)
     }
 
     /// `ray_sphere`'s filters never decide differently from the exact signs, and
@@ -952,3 +1136,7 @@ mod tests {
         assert!(Frustum::from_view_projection(Mat4::NAN).is_err());
     }
 }
+
+#[cfg(test)]
+#[path = "query_tests.rs"]
+mod query_tests;

@@ -1,8 +1,8 @@
 //! [`Sphere`]: the closed ball every broad-phase index stores.
 
-use crate::error::check_vec3;
+use crate::error::{check_radius, check_vec3};
 use crate::geom::Aabb;
-use crate::{Error, Result};
+use crate::Result;
 use glam::Vec3;
 
 /// A ball: every point within `radius` of `center` (boundary included).
@@ -25,17 +25,7 @@ impl Sphere {
     /// Checks that the centre and radius are finite and the radius is not negative.
     pub fn validate(&self) -> Result<()> {
         check_vec3(self.center, "sphere centre")?;
-        if !self.radius.is_finite() {
-            return Err(Error::NonFinite {
-                what: "sphere radius",
-            });
-        }
-        if self.radius < 0.0 {
-            return Err(Error::NegativeRadius {
-                radius: self.radius,
-            });
-        }
-        Ok(())
+        check_radius(self.radius, "sphere radius")
     }
 
     /// The smallest AABB containing the sphere.

@@ -134,6 +134,7 @@ impl Broad {
                 Query::Aabb(b) => overlap::sphere_aabb(s, b),
                 Query::Ray(r) => overlap::ray_sphere(r, s).is_some(),
                 Query::Frustum(fr) => overlap::frustum_sphere(fr, s) != Relation::Outside,
+                Query::Sweep(sw) => overlap::sweep_sphere(sw, s).is_some(),
             };
             if hit {
                 f(h.index());

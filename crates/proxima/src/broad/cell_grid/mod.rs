@@ -30,6 +30,7 @@ pub(crate) use hashed::Hashed;
 pub(crate) use store::Store;
 
 use crate::arena::Arena;
+use crate::broad::Filter;
 use crate::geom::Sphere;
 use crate::{Handle, Result};
 use keys::KeyBox;
@@ -70,6 +71,9 @@ pub(crate) struct CellGrid<T, S: Store> {
     /// A reference's handle and payload come from the arena slot itself (one
     /// memory access per hit, not two).
     spheres: Vec<Sphere>,
+    /// Slot → collision filter of the live object there (read only for pairs
+    /// that overlap and for filtered queries, so the spheres stay dense).
+    filters: Vec<Filter>,
     /// Growing bounds on the gridded spheres, for the cells' loose boxes.
     reach: Reach,
     /// Slots of the oversized objects.
@@ -85,6 +89,7 @@ impl<T, S: Store> CellGrid<T, S> {
             store,
             items: Arena::new(),
             spheres: Vec::new(),
+            filters: Vec::new(),
             reach: Reach::default(),
             oversized: Vec::new(),
             refs: 0,
@@ -131,8 +136,9 @@ impl<T, S: Store> CellGrid<T, S> {
         self.resolve(slot).0
     }
 
-    /// Stores an object. O(cells covered × references per cell).
-    pub fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    /// Stores an object with its filter. O(cells covered × references per
+    /// cell).
+    pub fn insert(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
         sphere.validate()?;
         self.items.check_room()?;
         let h = self.items.next_handle();
@@ -142,8 +148,10 @@ impl<T, S: Store> CellGrid<T, S> {
         debug_assert_eq!(h, h2);
         if self.spheres.len() <= slot as usize {
             self.spheres.resize(slot as usize + 1, sphere);
+            self.filters.resize(slot as usize + 1, filter);
         }
         self.spheres[slot as usize] = sphere;
+        self.filters[slot as usize] = filter;
         Ok(h)
     }
 
@@ -177,6 +185,25 @@ impl<T, S: Store> CellGrid<T, S> {
         Ok((self.spheres[handle.index() as usize], &item.value))
     }
 
+    /// The filter of a live handle.
+    pub fn filter(&self, handle: Handle) -> Result<Filter> {
+        self.items.get(handle)?;
+        Ok(self.filters[handle.index() as usize])
+    }
+
+    /// Replaces the filter of a live handle. O(1).
+    pub fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        self.items.get(handle)?;
+        self.filters[handle.index() as usize] = filter;
+        Ok(())
+    }
+
+    /// The filter of a live slot (callers pass reported handles' slots).
+    #[inline]
+    pub fn slot_filter(&self, slot: u32) -> Filter {
+        self.filters[slot as usize]
+    }
+
     /// The payload of a live handle, mutably.
     pub fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
         self.items.get_mut(handle).map(|i| &mut i.value)
@@ -192,6 +219,7 @@ impl<T, S: Store> CellGrid<T, S> {
         self.store.clear();
         self.items.clear();
         self.spheres = Vec::new();
+        self.filters = Vec::new();
         self.reach = Reach::default();
         self.oversized = Vec::new();
         self.refs = 0;
@@ -210,6 +238,7 @@ impl<T, S: Store> CellGrid<T, S> {
             + self.store.heap_bytes()
             + self.items.heap_bytes()
             + self.spheres.capacity() * std::mem::size_of::<Sphere>()
+            + self.filters.capacity() * std::mem::size_of::<Filter>()
             + self.oversized.capacity() * 4
     }
 }
@@ -220,12 +249,23 @@ impl<T, S: Store> CellGrid<T, S> {
 macro_rules! cell_grid_index {
     ($name:ident, $kind:expr) => {
         impl<T: Send + Sync> $crate::broad::SpatialIndex<T> for $name<T> {
-            fn insert(
+            fn insert_with_filter(
                 &mut self,
                 sphere: $crate::geom::Sphere,
+                filter: $crate::broad::Filter,
                 value: T,
             ) -> $crate::Result<$crate::Handle> {
-                self.grid.insert(sphere, value)
+                self.grid.insert(sphere, filter, value)
+            }
+            fn filter(&self, handle: $crate::Handle) -> $crate::Result<$crate::broad::Filter> {
+                self.grid.filter(handle)
+            }
+            fn set_filter(
+                &mut self,
+                handle: $crate::Handle,
+                filter: $crate::broad::Filter,
+            ) -> $crate::Result<()> {
+                self.grid.set_filter(handle, filter)
             }
             fn remove(&mut self, handle: $crate::Handle) -> $crate::Result<T> {
                 self.grid.remove(handle)
@@ -285,8 +325,21 @@ macro_rules! cell_grid_index {
                 self.grid.pairs(f)
             }
             #[inline]
-            fn first_hit(&self, ray: &$crate::geom::Ray) -> Option<$crate::broad::RayHit> {
-                self.grid.first_hit(ray)
+            fn filter_of(&self, h: $crate::Handle) -> $crate::broad::Filter {
+                self.grid.slot_filter(h.index())
+            }
+            #[inline]
+            fn object_count(&self) -> usize {
+                self.grid.len()
+            }
+            /// The cell walk along the ray, filtered at each candidate.
+            #[inline]
+            fn first_hit(
+                &self,
+                ray: &$crate::geom::Ray,
+                filter: Option<$crate::broad::Filter>,
+            ) -> Option<$crate::broad::RayHit> {
+                self.grid.first_hit(ray, filter)
             }
         }
     };

@@ -15,7 +15,8 @@ fn candidate(a: &Sphere, b: &Sphere) -> bool {
 }
 
 impl<T, S: Store> CellGrid<T, S> {
-    /// Calls `f` once per overlapping pair.
+    /// Calls `f` once per overlapping pair whose filters interact (checked
+    /// after the exact test: only overlapping pairs read the filters).
     ///
     /// Gridded pairs: two overlapping objects have overlapping footprints, so
     /// they share at least one cell. A pair found in cell `key` is reported only
@@ -52,6 +53,7 @@ impl<T, S: Store> CellGrid<T, S> {
                             (0..S::AXES).all(|a| la[a].max(lb[a]) == key[a])
                         }
                         && overlap::sphere_sphere(sa, sb)
+                        && self.filters[ea.slot as usize].interacts(self.filters[eb.slot as usize])
                     {
                         let (ha, va) = self.resolve(ea.slot);
                         let (hb, vb) = self.resolve(eb.slot);
@@ -64,14 +66,23 @@ impl<T, S: Store> CellGrid<T, S> {
         for (i, &a) in self.oversized.iter().enumerate() {
             let (ha, va) = self.resolve(a);
             let sa = &self.spheres[a as usize];
+            let fa = self.filters[a as usize];
             for &b in &self.oversized[i + 1..] {
-                if overlap::sphere_sphere(sa, &self.spheres[b as usize]) {
+                if fa.interacts(self.filters[b as usize])
+                    && overlap::sphere_sphere(sa, &self.spheres[b as usize])
+                {
                     let (hb, vb) = self.resolve(b);
                     f(ha, va, hb, vb)?;
                 }
             }
             let kb = self.store.lattice().sphere_box(sa, S::AXES);
-            self.visit_cells(sa, kb, &mut |hb, _, vb| f(ha, va, hb, vb))?;
+            self.visit_cells(sa, kb, &mut |hb, _, vb| {
+                if fa.interacts(self.filters[hb.index() as usize]) {
+                    f(ha, va, hb, vb)
+                } else {
+                    ControlFlow::Continue(())
+                }
+            })?;
         }
         ControlFlow::Continue(())
     }

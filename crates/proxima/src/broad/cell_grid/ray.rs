@@ -28,7 +28,7 @@ use super::keys::{Key, KeyBox, REL_PAD};
 use super::list::{CellEntry, Packed};
 use super::store::Store;
 use super::CellGrid;
-use crate::broad::RayHit;
+use crate::broad::{Filter, RayHit};
 use crate::geom::{overlap, Aabb, Ray, Sphere};
 use crate::Handle;
 use std::ops::ControlFlow;
@@ -359,20 +359,25 @@ impl<T, S: Store> CellGrid<T, S> {
         })
     }
 
-    /// The first hit (smallest `t`, ties by handle): the oversized objects
-    /// first, then the walk, stopping once a hit precedes the strip just
-    /// finished.
-    pub fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
+    /// The first hit (smallest `t`, ties by handle) among the objects `filter`
+    /// admits: the oversized objects first, then the walk, stopping once a hit
+    /// precedes the strip just finished.
+    pub fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
+        let admits = |slot: u32| filter.map_or(true, |f| f.interacts(self.filters[slot as usize]));
         for &slot in &self.oversized {
             if let Some(t) = overlap::ray_sphere(ray, &self.spheres[slot as usize]) {
-                RayHit::offer(&mut best, t, self.handle(slot));
+                if admits(slot) {
+                    RayHit::offer(&mut best, t, self.handle(slot));
+                }
             }
         }
         let _ = self.walk_ray(ray, |s| match s {
             Step::Candidate(e) => {
                 if let Some(t) = overlap::ray_sphere(ray, &self.spheres[e.slot as usize]) {
-                    RayHit::offer(&mut best, t, self.handle(e.slot));
+                    if admits(e.slot) {
+                        RayHit::offer(&mut best, t, self.handle(e.slot));
+                    }
                 }
                 ControlFlow::Continue(())
             }

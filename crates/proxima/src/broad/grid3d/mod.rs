@@ -15,7 +15,7 @@ mod validate;
 
 use crate::arena::Arena;
 use crate::broad::walk::{walk_methods, Walk};
-use crate::broad::{IndexKind, SceneHint, Selection, SpatialIndex};
+use crate::broad::{Filter, IndexKind, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Sphere};
 use crate::{Error, Handle, Result};
 use cells::{CellStore, Geometry, NO_CELL};
@@ -96,7 +96,8 @@ struct Loc {
 /// blocks instead: blocks outside the query are skipped and blocks whose
 /// centres lie inside it are reported without tests (see `query`), so a
 /// frustum costs O(blocks near its boundary + objects inside), not O(cells). Memory: 16 bytes per cell, 8 per
-/// object for its location, 16 for its sphere, plus the payloads.
+/// object for its location, 16 for its sphere, 8 for its filter, plus the
+/// payloads.
 #[derive(Clone, Debug)]
 pub struct UniformGrid3d<T> {
     geom: Geometry,
@@ -106,6 +107,9 @@ pub struct UniformGrid3d<T> {
     locs: Vec<Loc>,
     /// Slot → sphere.
     spheres: Vec<Sphere>,
+    /// Slot → collision filter (read for reported pairs and filtered queries
+    /// only, so the scans' sphere array stays dense).
+    filters: Vec<Filter>,
     /// Slots of the large objects.
     large: Vec<u32>,
     /// Union of the gridded spheres' boxes since the grid was created, cleared or
@@ -133,6 +137,7 @@ impl<T> UniformGrid3d<T> {
             items: Arena::new(),
             locs: Vec::new(),
             spheres: Vec::new(),
+            filters: Vec::new(),
             large: Vec::new(),
             extent: Aabb::EMPTY,
         })
@@ -216,7 +221,7 @@ impl<T> UniformGrid3d<T> {
 }
 
 impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
-    fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
         sphere.validate()?;
         // Room first: a full arena must leave the grid exactly as it was.
         self.items.check_room()?;
@@ -227,9 +232,11 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
         if self.locs.len() <= slot as usize {
             self.locs.resize(slot as usize + 1, loc);
             self.spheres.resize(slot as usize + 1, sphere);
+            self.filters.resize(slot as usize + 1, filter);
         }
         self.locs[slot as usize] = loc;
         self.spheres[slot as usize] = sphere;
+        self.filters[slot as usize] = filter;
         Ok(h)
     }
 
@@ -274,6 +281,17 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
         self.items.get_mut(handle)
     }
 
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        self.items.get(handle)?;
+        Ok(self.filters[handle.index() as usize])
+    }
+
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        self.items.get(handle)?;
+        self.filters[handle.index() as usize] = filter;
+        Ok(())
+    }
+
     fn len(&self) -> usize {
         self.items.len()
     }
@@ -286,6 +304,7 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
             items: Arena::new(),
             locs: Vec::new(),
             spheres: Vec::new(),
+            filters: Vec::new(),
             large: Vec::new(),
             extent: Aabb::EMPTY,
         };
@@ -310,6 +329,7 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
             + self.locs.capacity() * std::mem::size_of::<Loc>()
             + self.large.capacity() * 4
             + self.spheres.capacity() * std::mem::size_of::<Sphere>()
+            + self.filters.capacity() * std::mem::size_of::<Filter>()
     }
 
     fn kind(&self) -> IndexKind {
@@ -342,6 +362,14 @@ impl<T> Walk<T> for UniformGrid3d<T> {
             }
         }
         ControlFlow::Continue(())
+    }
+
+    fn filter_of(&self, h: Handle) -> Filter {
+        self.filters[h.index() as usize]
+    }
+
+    fn object_count(&self) -> usize {
+        self.items.len()
     }
 
     fn walk_pairs(

@@ -64,6 +64,9 @@ impl Batch {
     ) -> ControlFlow<()> {
         let n = std::mem::replace(&mut self.len, 0);
         for &(a, b) in &self.pairs[..n] {
+            if !g.filters[a as usize].interacts(g.filters[b as usize]) {
+                continue;
+            }
             let (ha, va) = g.resolve(a);
             let (hb, vb) = g.resolve(b);
             f(ha, va, hb, vb)?;
@@ -350,14 +353,23 @@ impl<T> UniformGrid3d<T> {
     ) -> ControlFlow<()> {
         let (ha, va) = self.resolve(self.large[i]);
         let sa = &self.spheres[self.large[i] as usize];
+        let fa = self.filters[self.large[i] as usize];
         for &b in &self.large[i + 1..] {
-            if overlap::sphere_sphere(sa, &self.spheres[b as usize]) {
+            if fa.interacts(self.filters[b as usize])
+                && overlap::sphere_sphere(sa, &self.spheres[b as usize])
+            {
                 let (hb, vb) = self.resolve(b);
                 f(ha, va, hb, vb)?;
             }
         }
         let (lo, hi) = self.geom.range(&sa.aabb());
-        self.visit_range(sa, lo, hi, &mut |hb, _, vb| f(ha, va, hb, vb))
+        self.visit_range(sa, lo, hi, &mut |hb, _, vb| {
+            if fa.interacts(self.filters[hb.index() as usize]) {
+                f(ha, va, hb, vb)
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
     }
 }
 

@@ -6,6 +6,7 @@ use super::node::{all_space, Node, NIL};
 use super::store::room_for;
 use super::{Loc, LooseKdTree};
 use crate::arena::Pool;
+use crate::broad::Filter;
 use crate::geom::Sphere;
 use crate::Handle;
 
@@ -70,7 +71,14 @@ impl<T> LooseKdTree<T> {
     /// Places an object in `node`'s range and records its location. O(1)
     /// amortized: a full range first moves to the end of the array with twice
     /// the room (the old range becomes dead).
-    pub(super) fn put(&mut self, node: u32, sphere: Sphere, handle: Handle, value: T) {
+    pub(super) fn put(
+        &mut self,
+        node: u32,
+        sphere: Sphere,
+        handle: Handle,
+        filter: Filter,
+        value: T,
+    ) {
         let (start, len, cap) = {
             let n = &self.nodes[node];
             (n.start, n.len, n.cap)
@@ -95,23 +103,38 @@ impl<T> LooseKdTree<T> {
         };
         let p = (start + len) as usize;
         self.store.set(p, sphere);
-        self.store.entry[p] = Some((handle, value));
+        self.store.entry[p] = Some((handle, filter, value));
         self.nodes[node].len = len + 1;
+        self.widen_filters(node, filter);
         *self
             .items
             .get_by_index_mut(handle.index())
             .expect("placing a live item") = Loc { node, pos: len };
     }
 
+    /// ORs `filter` into the filter bits of `node` and its ancestors, stopping
+    /// where they already hold it. O(depth), usually O(1).
+    pub(super) fn widen_filters(&mut self, mut node: u32, filter: Filter) {
+        while node != NIL {
+            let n = &mut self.nodes[node];
+            let (g, m) = (n.groups | filter.group, n.masks | filter.mask);
+            if (g, m) == (n.groups, n.masks) {
+                break;
+            }
+            (n.groups, n.masks) = (g, m);
+            node = n.parent;
+        }
+    }
+
     /// Takes the object at `loc` out of its node ([sources: kd-remove]: `DeleteItem`) by moving the
     /// node's last object into the hole, whose location is updated. O(1). The
     /// taken object's own location is stale until it is placed again.
-    pub(super) fn take(&mut self, loc: Loc) -> (Sphere, Handle, T) {
+    pub(super) fn take(&mut self, loc: Loc) -> (Sphere, Handle, Filter, T) {
         let n = &mut self.nodes[loc.node];
         n.len -= 1;
         let (p, last) = ((n.start + loc.pos) as usize, (n.start + n.len) as usize);
         let sphere = self.store.sphere[p];
-        let (handle, value) = self.store.entry[p].take().expect("live position");
+        let (handle, filter, value) = self.store.entry[p].take().expect("live position");
         if p != last {
             self.store.set(p, self.store.sphere[last]);
             let moved = self.store.entry[last].take();
@@ -122,7 +145,7 @@ impl<T> LooseKdTree<T> {
                 .expect("moved item is live")
                 .pos = loc.pos;
         }
-        (sphere, handle, value)
+        (sphere, handle, filter, value)
     }
 
     /// Compacts the object array if its dead positions have outgrown the live
@@ -169,7 +192,7 @@ impl<T> LooseKdTree<T> {
                     p.child[side] = new;
                 }
                 for i in 0..node.len as usize {
-                    let (h, _) = store.entry[at as usize + i].as_ref().expect("live");
+                    let (h, _, _) = store.entry[at as usize + i].as_ref().expect("live");
                     self.items
                         .get_by_index_mut(h.index())
                         .expect("live item")

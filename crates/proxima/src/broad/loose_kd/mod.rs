@@ -10,6 +10,7 @@
 //! `validate.rs`, `stats.rs`, `visit.rs` (read-only node walk for pictures).
 
 mod insert;
+mod nearest;
 mod node;
 mod pairs;
 #[cfg(feature = "parallel")]
@@ -30,7 +31,7 @@ pub use visit::KdNodeView;
 use crate::arena::{Arena, Pool};
 
 use crate::broad::walk::{walk_methods, Walk};
-use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
+use crate::broad::{Filter, IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Handle, Result};
 use node::{Node, NIL};
@@ -275,6 +276,12 @@ impl<T> LooseKdTree<T> {
         }
     }
 
+    /// Position in the object array of the object at `loc`.
+    #[inline]
+    fn position(&self, loc: Loc) -> usize {
+        (self.nodes[loc.node].start + loc.pos) as usize
+    }
+
     /// Forgets the bounds of removed objects once nothing is stored.
     fn reset_span_if_empty(&mut self) {
         if self.items.is_empty() {
@@ -286,7 +293,7 @@ impl<T> LooseKdTree<T> {
 
 impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     /// `Push` [sources: kd-insert]: O(depth), creating the missing nodes on the way.
-    fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
         sphere.validate()?;
         // Before `cover` and `descend` change the tree: a full index stays as it was.
         self.items.check_room()?;
@@ -294,7 +301,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         let root = self.ensure_root();
         let node = self.descend(root, &sphere);
         let handle = self.items.insert(Loc { node, pos: 0 })?;
-        self.put(node, sphere, handle, value);
+        self.put(node, sphere, handle, filter, value);
         self.maybe_compact();
         Ok(handle)
     }
@@ -302,7 +309,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     /// `Pop` [sources: kd-remove]: O(1) swap-remove from the node, then frees emptied nodes upwards.
     fn remove(&mut self, handle: Handle) -> Result<T> {
         let loc = *self.items.get(handle)?;
-        let (_, _, value) = self.take(loc);
+        let (_, _, _, value) = self.take(loc);
         self.prune_up(loc.node);
         self.items.remove(handle)?;
         self.reset_span_if_empty();
@@ -330,8 +337,21 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
         let loc = *self.items.get(handle)?;
         let p = (self.nodes[loc.node].start + loc.pos) as usize;
-        let (_, v) = self.store.entry[p].as_mut().expect("live position");
+        let (_, _, v) = self.store.entry[p].as_mut().expect("live position");
         Ok(v)
+    }
+
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        let loc = self.items.get(handle)?;
+        Ok(self.store.full(self.position(*loc)).1)
+    }
+
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        let loc = *self.items.get(handle)?;
+        let p = self.position(loc);
+        self.store.entry[p].as_mut().expect("live position").1 = filter;
+        self.widen_filters(loc.node, filter);
+        Ok(())
     }
 
     fn len(&self) -> usize {
@@ -384,7 +404,22 @@ impl<T> Walk<T> for LooseKdTree<T> {
         query: &Q,
         f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        self.visit_impl(query, f)
+        self.visit_impl(query, (), f)
+    }
+
+    /// The same walk, skipping every subtree whose filter bits (the OR of its
+    /// objects' groups and masks) cannot interact with `filter`, and every
+    /// object whose own filter does not.
+    fn walk_filtered<Q: Selection + ?Sized>(
+        &self,
+        query: &Q,
+        filter: Option<Filter>,
+        f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        match filter {
+            None => self.visit_impl(query, (), f),
+            Some(q) => self.visit_impl(query, q, f),
+        }
     }
 
     /// Node-vs-node walk over the nodes' contiguous objects (see `pairs.rs`). Its
@@ -397,9 +432,37 @@ impl<T> Walk<T> for LooseKdTree<T> {
         self.pairs_impl(f)
     }
 
+    fn filter_of(&self, h: Handle) -> Filter {
+        let loc = self.items.get(h).expect("a live handle");
+        self.store.full(self.position(*loc)).1
+    }
+
+    fn object_count(&self) -> usize {
+        self.items.len()
+    }
+
+    /// Branch and bound over the node regions (`nearest.rs`).
+    fn knn_into(
+        &self,
+        query: &crate::broad::Nearest,
+        filter: Option<Filter>,
+        out: &mut Vec<crate::broad::Neighbor>,
+    ) {
+        self.nearest_impl(query, filter, out)
+    }
+
     /// Front-to-back: nearer child first, subtrees whose region the ray enters
     /// after the best hit so far are skipped.
-    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
-        self.ray_first_impl(ray)
+    fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
+        self.first_impl(ray, filter)
+    }
+
+    /// The same front-to-back search, pruning by the sweep's box entry.
+    fn first_sweep_hit(
+        &self,
+        sweep: &crate::geom::SphereSweep,
+        filter: Option<Filter>,
+    ) -> Option<RayHit> {
+        self.first_impl(sweep, filter)
     }
 }

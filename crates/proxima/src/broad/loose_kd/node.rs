@@ -49,6 +49,13 @@ pub(super) struct Node {
     pub cell: Aabb,
     /// The box `B` of [sources: kd-border]: the world box, narrowed by one face per split above.
     pub bbox: Aabb,
+    /// OR of the groups and of the masks of the filters of every object in
+    /// the subtree, or a superset (they only grow while the node lives): a
+    /// filtered query skips the subtree when its filter cannot interact with
+    /// them ([`Filter::may_interact`](crate::broad::Filter::may_interact)).
+    /// After the box, in the second cache line: only filtered walks read it.
+    pub groups: u32,
+    pub masks: u32,
 }
 
 impl Node {
@@ -79,6 +86,8 @@ impl Node {
             axis,
             depth,
             loose: false,
+            groups: 0,
+            masks: 0,
         }
     }
 

@@ -357,7 +357,8 @@ impl<T> LooseKdTree<T> {
         self.self_pairs(self.root, 0, b, &mut f)
     }
 
-    /// Reports carried entry `i` with carried entry `j`.
+    /// Reports carried entry `i` with carried entry `j`, if their filters
+    /// interact.
     #[inline]
     fn report(
         &self,
@@ -366,12 +367,11 @@ impl<T> LooseKdTree<T> {
         j: usize,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let (xh, xv) = self.store.at(c.origin(i));
-        let (yh, yv) = self.store.at(c.origin(j));
-        f(xh, xv, yh, yv)
+        self.report_at(c, i, c.origin(j), f)
     }
 
-    /// Reports carried entry `i` with the object at position `y`.
+    /// Reports carried entry `i` with the object at position `y`, if their
+    /// filters interact (read from the entries the report reads anyway).
     #[inline]
     fn report_at(
         &self,
@@ -380,9 +380,13 @@ impl<T> LooseKdTree<T> {
         y: usize,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let (xh, xv) = self.store.at(c.origin(i));
-        let (yh, yv) = self.store.at(y);
-        f(xh, xv, yh, yv)
+        let (xh, xf, xv) = self.store.full(c.origin(i));
+        let (yh, yf, yv) = self.store.full(y);
+        if xf.interacts(yf) {
+            f(xh, xv, yh, yv)
+        } else {
+            ControlFlow::Continue(())
+        }
     }
 
     /// Whether to narrow the carried set before visiting node `c`. The filter only

@@ -4,8 +4,10 @@
 use super::node::{FixedStack, NIL};
 use super::store::CHUNK;
 use super::LooseKdTree;
-use crate::broad::{RayHit, Selection};
-use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
+use crate::broad::filter::Admit;
+use crate::broad::walk::Cast;
+use crate::broad::{Filter, RayHit, Selection};
+use crate::geom::{Aabb, Frustum, Relation, Sphere};
 use crate::Handle;
 use glam::Vec3;
 use std::ops::{ControlFlow, Range};
@@ -52,9 +54,15 @@ impl<T> LooseKdTree<T> {
     ///    subtree, `Inside` reports it whole without tests (valid because the
     ///    selection promises `Inside` only when every sphere inside the box is
     ///    selected). Queries without bounds (frustums) rely on this one alone.
-    pub(super) fn visit_impl<Q: Selection + ?Sized>(
+    ///
+    /// `admit` is `()` for an unfiltered walk (compiled away) or the query's
+    /// [`Filter`]: then a node whose filter bits cannot interact with it is
+    /// skipped with its subtree, and each object is reported only if its own
+    /// filter interacts.
+    pub(super) fn visit_impl<Q: Selection + ?Sized, A: Admit>(
         &self,
         query: &Q,
+        admit: A,
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         if self.root == NIL {
@@ -89,8 +97,11 @@ impl<T> LooseKdTree<T> {
         );
         while let Some(p) = stack.pop() {
             let node = &self.nodes[p.node];
+            if !admit.node(node.groups, node.masks) {
+                continue;
+            }
             if p.inside {
-                self.report_all(node.range(), &mut f)?;
+                self.report_all(node.range(), admit, &mut f)?;
                 for c in node.child {
                     if c != NIL {
                         stack.push(Pending {
@@ -135,23 +146,40 @@ impl<T> LooseKdTree<T> {
             // The node's own objects after its children are classified: the
             // children's tests need only this node's fields, and the scan's
             // first load (the node's range of the object array) is the miss.
-            self.scan(node.range(), node.loose, query, p.mask, &mut f)?;
+            self.scan(node.range(), node.loose, query, p.mask, admit, &mut f)?;
         }
         ControlFlow::Continue(())
     }
 
     /// Reports every object at positions `range`, without tests.
     #[inline(always)]
-    fn report_all(
+    fn report_all<A: Admit>(
         &self,
         range: Range<usize>,
+        admit: A,
         f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         for (q, s) in range.clone().zip(&self.store.sphere[range]) {
-            let (h, v) = self.store.at(q);
-            f(h, s, v)?;
+            self.report_admitted(q, s, admit, f)?;
         }
         ControlFlow::Continue(())
+    }
+
+    /// Reports the object at position `q` if `admit` admits its filter.
+    #[inline(always)]
+    fn report_admitted<A: Admit>(
+        &self,
+        q: usize,
+        s: &Sphere,
+        admit: A,
+        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        let (h, of, v) = self.store.full(q);
+        if admit.object(of) {
+            f(h, s, v)
+        } else {
+            ControlFlow::Continue(())
+        }
     }
 
     /// Reports the objects at positions `range` (one node's) that `query`
@@ -164,12 +192,14 @@ impl<T> LooseKdTree<T> {
     /// chunk test costs about as much as two sphere tests), and so are the
     /// objects of a `loose` node (its bounds may miss moved objects).
     #[inline(always)]
-    fn scan<Q: Selection + ?Sized>(
+    #[allow(clippy::too_many_arguments)]
+    fn scan<Q: Selection + ?Sized, A: Admit>(
         &self,
         range: Range<usize>,
         loose: bool,
         query: &Q,
         mask: u8,
+        admit: A,
         f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let mut p = range.start;
@@ -185,14 +215,14 @@ impl<T> LooseKdTree<T> {
                         continue;
                     }
                     Relation::Inside => {
-                        self.report_all(p..end, f)?;
+                        self.report_all(p..end, admit, f)?;
                         p = end;
                         continue;
                     }
                     Relation::Intersecting => {}
                 }
             }
-            self.test_each(p..end, query, f)?;
+            self.test_each(p..end, query, admit, f)?;
             p = end;
         }
         ControlFlow::Continue(())
@@ -201,59 +231,67 @@ impl<T> LooseKdTree<T> {
     /// Reports the objects at positions `range` that `query` selects, testing
     /// each one.
     #[inline(always)]
-    fn test_each<Q: Selection + ?Sized>(
+    fn test_each<Q: Selection + ?Sized, A: Admit>(
         &self,
         range: Range<usize>,
         query: &Q,
+        admit: A,
         f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         for (q, s) in range.clone().zip(&self.store.sphere[range]) {
             if query.selects(s) {
-                let (h, v) = self.store.at(q);
-                f(h, s, v)?;
+                self.report_admitted(q, s, admit, f)?;
             }
         }
         ControlFlow::Continue(())
     }
 
-    /// Smallest entry `t` (ties: smallest handle) by a front-to-back walk: the
-    /// ray's `max_t` shrinks to the best hit so far, children are visited nearer
-    /// entry first, and a subtree whose region (which contains all its spheres) the
-    /// shortened ray does not reach is skipped. `t` values come from the same
-    /// `overlap::ray_sphere` on the unshortened ray, as in the default scan, so the
-    /// answer is identical: a pruned box has `ray_aabb`'s entry bound above the
-    /// best `t`, and that bound is at most the `t` of every sphere inside.
-    pub(super) fn ray_first_impl(&self, ray: &Ray) -> Option<RayHit> {
+    /// Smallest contact `t` of a ray or sweep (ties: smallest handle) by a
+    /// front-to-back walk: children are visited nearer entry first, and a
+    /// subtree whose region (which contains all its spheres) the cast enters
+    /// after the best contact so far is skipped. `t` values come from the same
+    /// [`Cast::contact`] as in the default scan, so the answer is identical: a
+    /// pruned box has an entry bound ([`Cast::enter`]) above the best `t`, and
+    /// that bound is at most the `t` of every sphere inside (for a ray: the
+    /// `ray_aabb` entry; for a sweep: `sweep_aabb`'s, which `sweep_sphere`'s
+    /// `t` is clamped to respect). Objects whose filter does not interact with
+    /// `filter` are skipped at the candidate, and subtrees whose filter bits
+    /// cannot interact with it are skipped whole.
+    pub(super) fn first_impl<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         if self.root == NIL {
             return None;
         }
-        let mut r = *ray;
         let mut best: Option<RayHit> = None;
+        let beyond = |best: &Option<RayHit>, t: f32| best.is_some_and(|b| t > b.t);
         let mut stack = FixedStack::<(u32, f32)>::new();
-        if let Some((t0, _)) = overlap::ray_aabb(&r, &self.region(&self.nodes[self.root])) {
+        if let Some(t0) = cast.enter(&self.region(&self.nodes[self.root])) {
             stack.push((self.root, t0));
         }
         while let Some((n, t_enter)) = stack.pop() {
-            if t_enter > r.max_t {
+            if beyond(&best, t_enter) {
                 continue;
             }
             let node = &self.nodes[n];
+            if filter.is_some_and(|f| !f.may_interact(node.groups, node.masks)) {
+                continue;
+            }
             for (q, s) in node.range().zip(&self.store.sphere[node.range()]) {
-                // The full ray: its `t` is what brute force reports (`ray_sphere`
-                // clamps into `[.., max_t]`); the shortened `r` only prunes boxes.
-                if let Some(t) = overlap::ray_sphere(ray, s).filter(|&t| t <= r.max_t) {
-                    let h = self.store.at(q).0;
-                    if RayHit::offer(&mut best, t, h) {
-                        r.max_t = t;
+                if let Some(t) = cast.contact(s).filter(|&t| !beyond(&best, t)) {
+                    let (h, of, _) = self.store.full(q);
+                    if filter.is_some_and(|f| !f.interacts(of)) {
+                        continue;
                     }
+                    RayHit::offer(&mut best, t, h);
                 }
             }
             let mut entries = [(NIL, f32::INFINITY); 2];
             for (side, e) in entries.iter_mut().enumerate() {
                 let c = node.child[side];
                 if c != NIL {
-                    if let Some((t0, _)) = overlap::ray_aabb(&r, &self.region(&self.nodes[c])) {
-                        *e = (c, t0);
+                    if let Some(t0) = cast.enter(&self.region(&self.nodes[c])) {
+                        if !beyond(&best, t0) {
+                            *e = (c, t0);
+                        }
                     }
                 }
             }

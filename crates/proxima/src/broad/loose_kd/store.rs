@@ -27,6 +27,7 @@
 //! are far from a small query. A box may cover objects of two neighbouring
 //! ranges (ranges are not aligned to chunks): it is looser, never wrong.
 
+use crate::broad::Filter;
 use crate::geom::{Aabb, Sphere};
 use crate::Handle;
 use glam::Vec3;
@@ -35,8 +36,11 @@ use glam::Vec3;
 /// saves two lines and eight tests for one 24-byte box.
 pub(super) const CHUNK: usize = 8;
 
-/// Spheres, and handle and payload, by position. Positions in dead ranges or
-/// past a node's `len` hold an old sphere and `None`.
+/// Spheres, and handle, filter and payload, by position. Positions in dead
+/// ranges or past a node's `len` hold an old sphere and `None`. The filter is
+/// kept with the handle and payload, not with the sphere: only reported
+/// objects read it (the pair search's and queries' inner loops read spheres
+/// only), so it costs them nothing.
 #[derive(Clone, Debug)]
 pub(super) struct Store<T> {
     /// Written through [`Store::set`], which keeps `chunk`, except by in-place
@@ -45,7 +49,7 @@ pub(super) struct Store<T> {
     /// `chunk[p / CHUNK]` contains `sphere[p].aabb()` for every live position
     /// `p` of a node that is not `loose`.
     pub chunk: Vec<Aabb>,
-    pub entry: Vec<Option<(Handle, T)>>,
+    pub entry: Vec<Option<(Handle, Filter, T)>>,
     /// Positions in ranges no node owns any more (freed nodes, moved ranges).
     pub dead: usize,
     /// Ranges moved to the end and nodes created since the last compaction: each
@@ -106,15 +110,22 @@ impl<T> Store<T> {
     /// Handle and payload at live position `p`.
     #[inline]
     pub fn at(&self, p: usize) -> (Handle, &T) {
-        let (h, v) = self.entry[p].as_ref().expect("live position");
+        let (h, _, v) = self.entry[p].as_ref().expect("live position");
         (*h, v)
+    }
+
+    /// Handle, filter and payload at live position `p`.
+    #[inline]
+    pub fn full(&self, p: usize) -> (Handle, Filter, &T) {
+        let (h, f, v) = self.entry[p].as_ref().expect("live position");
+        (*h, *f, v)
     }
 
     /// Bytes of heap memory held.
     pub fn heap_bytes(&self) -> usize {
         self.sphere.capacity() * std::mem::size_of::<Sphere>()
             + self.chunk.capacity() * std::mem::size_of::<Aabb>()
-            + self.entry.capacity() * std::mem::size_of::<Option<(Handle, T)>>()
+            + self.entry.capacity() * std::mem::size_of::<Option<(Handle, Filter, T)>>()
     }
 }
 

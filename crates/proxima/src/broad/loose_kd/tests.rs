@@ -336,10 +336,10 @@ fn ray_first_ties_go_to_the_smallest_handle() {
         b.insert(s, i).unwrap();
     }
     let ray = Ray::new(vec3(0.0, 50.0, 50.0), Vec3::X);
-    let hit = t.ray_first(&ray).unwrap().unwrap();
+    let hit = t.ray_first(&ray, None).unwrap().unwrap();
     assert_eq!(hit.t, 49.0);
     assert_eq!(hit.handle, *hs.iter().min().unwrap());
-    assert_eq!(b.ray_first(&ray).unwrap().unwrap().t, 49.0);
+    assert_eq!(b.ray_first(&ray, None).unwrap().unwrap().t, 49.0);
 }
 
 #[test]

@@ -52,7 +52,7 @@ impl<T> LooseKdTree<T> {
             self.store.sphere[p] = s;
             return;
         }
-        let (_, handle, value) = self.take(loc);
+        let (_, handle, filter, value) = self.take(loc);
         let mut cur = loc.node;
         while !self.nodes[cur].routes(&s) {
             let parent = self.nodes[cur].parent;
@@ -61,7 +61,7 @@ impl<T> LooseKdTree<T> {
             cur = parent;
         }
         let target = self.descend(cur, &s);
-        self.put(target, s, handle, value);
+        self.put(target, s, handle, filter, value);
         self.maybe_compact();
     }
 }

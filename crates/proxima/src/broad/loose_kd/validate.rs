@@ -112,9 +112,13 @@ impl<T> LooseKdTree<T> {
                 }
             }
             for (pos, p) in node.range().enumerate() {
-                let Some((handle, _)) = &self.store.entry[p] else {
+                let Some((handle, filter, _)) = &self.store.entry[p] else {
                     return fail(format!("node {n}: live position {p} empty"));
                 };
+                // Filtered walks skip a node on its filter bits.
+                if filter.group & !node.groups != 0 || filter.mask & !node.masks != 0 {
+                    return fail(format!("node {n}: filter bits miss an object's"));
+                }
                 match self.items.get(*handle) {
                     Ok(loc) if loc.node == n && loc.pos as usize == pos => {}
                     _ => {
@@ -144,6 +148,10 @@ impl<T> LooseKdTree<T> {
                 if c != NIL {
                     if (c as usize) >= slots || free[c as usize] || self.nodes[c].parent != n {
                         return fail(format!("node {n}: child {c} bad or not linked back"));
+                    }
+                    let ch = &self.nodes[c];
+                    if ch.groups & !node.groups != 0 || ch.masks & !node.masks != 0 {
+                        return fail(format!("node {n}: filter bits miss child {c}'s"));
                     }
                     stack.push(c);
                 }

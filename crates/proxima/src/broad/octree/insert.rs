@@ -4,6 +4,7 @@
 use super::code::MAX_DEPTH;
 use super::node::{Item, Obj, NONE};
 use super::LinearOctree;
+use crate::broad::Filter;
 use crate::geom::Sphere;
 use crate::Handle;
 use crate::Result;
@@ -11,7 +12,12 @@ use crate::Result;
 impl<T> LinearOctree<T> {
     /// Inserts an already validated sphere: locate the leaf from the centre's code,
     /// append, update counts and extents up the chain, split if over capacity.
-    pub(super) fn insert_valid(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    pub(super) fn insert_valid(
+        &mut self,
+        sphere: Sphere,
+        filter: Filter,
+        value: T,
+    ) -> Result<Handle> {
         let (key, ext) = self.placement(&sphere);
         let handle = self.objects.insert(Obj {
             sphere,
@@ -19,6 +25,7 @@ impl<T> LinearOctree<T> {
             ext,
             leaf: NONE,
             slot: 0,
+            filter,
             value,
         })?;
         let start = self.locate(key);

@@ -6,6 +6,7 @@
 
 mod code;
 mod insert;
+mod nearest;
 mod neighbors;
 mod node;
 mod pairs;
@@ -25,7 +26,7 @@ pub use stats::OctreeStats;
 use crate::arena::{Arena, Pool};
 
 use crate::broad::walk::{walk_methods, Walk};
-use crate::broad::{IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
+use crate::broad::{Filter, IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::{Error, Handle, Result};
 use glam::Vec3;
@@ -253,9 +254,9 @@ impl<T> LinearOctree<T> {
 }
 
 impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
-    fn insert(&mut self, sphere: Sphere, value: T) -> Result<Handle> {
+    fn insert_with_filter(&mut self, sphere: Sphere, filter: Filter, value: T) -> Result<Handle> {
         sphere.validate()?;
-        self.insert_valid(sphere, value)
+        self.insert_valid(sphere, filter, value)
     }
 
     fn remove(&mut self, handle: Handle) -> Result<T> {
@@ -275,6 +276,18 @@ impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
 
     fn get_mut(&mut self, handle: Handle) -> Result<&mut T> {
         self.objects.get_mut(handle).map(|o| &mut o.value)
+    }
+
+    fn filter(&self, handle: Handle) -> Result<Filter> {
+        self.objects.get(handle).map(|o| o.filter)
+    }
+
+    fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
+        let o = self.objects.get_mut(handle)?;
+        o.filter = filter;
+        let leaf = o.leaf;
+        self.widen_filters(leaf, filter);
+        Ok(())
     }
 
     fn len(&self) -> usize {
@@ -312,7 +325,22 @@ impl<T> Walk<T> for LinearOctree<T> {
         query: &Q,
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        self.visit_tree(query, &mut f)
+        self.visit_tree(query, (), &mut f)
+    }
+
+    /// The same walk, skipping every subtree whose filter bits (the OR of its
+    /// objects' groups and masks) cannot interact with `filter`, and every
+    /// object whose own filter does not.
+    fn walk_filtered<Q: Selection + ?Sized>(
+        &self,
+        query: &Q,
+        filter: Option<Filter>,
+        mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        match filter {
+            None => self.visit_tree(query, (), &mut f),
+            Some(q) => self.visit_tree(query, q, &mut f),
+        }
     }
 
     fn walk_pairs(
@@ -322,9 +350,36 @@ impl<T> Walk<T> for LinearOctree<T> {
         self.pairs_tree(&mut f)
     }
 
+    fn filter_of(&self, h: Handle) -> Filter {
+        self.obj(h).filter
+    }
+
+    fn object_count(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Branch and bound over the loose boxes (`nearest.rs`).
+    fn knn_into(
+        &self,
+        query: &crate::broad::Nearest,
+        filter: Option<Filter>,
+        out: &mut Vec<crate::broad::Neighbor>,
+    ) {
+        self.nearest_tree(query, filter, out)
+    }
+
     /// Front-to-back: children in order of entry along the ray, subtrees entered
     /// after the best hit so far skipped.
-    fn first_hit(&self, ray: &Ray) -> Option<RayHit> {
-        self.ray_first_tree(ray)
+    fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
+        self.first_tree(ray, filter)
+    }
+
+    /// The same front-to-back search, pruning by the sweep's box entry.
+    fn first_sweep_hit(
+        &self,
+        sweep: &crate::geom::SphereSweep,
+        filter: Option<Filter>,
+    ) -> Option<RayHit> {
+        self.first_tree(sweep, filter)
     }
 }

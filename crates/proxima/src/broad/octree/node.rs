@@ -4,6 +4,7 @@
 use super::code::{cell_box_of, point_key, LocationCode, MAX_DEPTH};
 use super::LinearOctree;
 use crate::arena::{Arena, Pool};
+use crate::broad::Filter;
 use crate::geom::{Aabb, Sphere};
 use crate::Handle;
 use glam::Vec3;
@@ -33,6 +34,9 @@ pub(super) struct Obj<T> {
     /// Leaf node index and position in its item list.
     pub leaf: u32,
     pub slot: u32,
+    /// The collision filter: read with the payload when a pair is reported,
+    /// never by the walks themselves.
+    pub filter: Filter,
     pub value: T,
 }
 
@@ -50,6 +54,12 @@ pub(super) struct Node {
     pub leaf: bool,
     pub children: [u32; 8],
     pub items: Vec<Item>,
+    /// OR of the groups and of the masks of the filters of every object in
+    /// the subtree, or a superset (they only grow while the node lives;
+    /// `validate` checks the superset): filtered walks skip the subtree when
+    /// the query's filter cannot interact with them.
+    pub groups: u32,
+    pub masks: u32,
 }
 
 impl<T> LinearOctree<T> {
@@ -64,6 +74,8 @@ impl<T> LinearOctree<T> {
             leaf: true,
             children: [NONE; 8],
             items,
+            groups: 0,
+            masks: 0,
         });
         self.map.insert(code.raw(), i);
         self.per_depth[code.depth() as usize] += 1;
@@ -174,6 +186,23 @@ impl<T> LinearOctree<T> {
         let o = self.obj_mut(item.handle);
         o.leaf = leaf;
         o.slot = slot;
+        let filter = o.filter;
+        self.widen_filters(leaf, filter);
+    }
+
+    /// ORs `filter` into the filter bits of `from` and its ancestors, stopping
+    /// where they already hold it. O(depth), usually O(1).
+    #[inline]
+    pub(super) fn widen_filters(&mut self, mut from: u32, filter: Filter) {
+        while from != NONE {
+            let n = &mut self.nodes[from];
+            let (g, m) = (n.groups | filter.group, n.masks | filter.mask);
+            if (g, m) == (n.groups, n.masks) {
+                return;
+            }
+            (n.groups, n.masks) = (g, m);
+            from = n.parent;
+        }
     }
 
     /// Removes the item at `slot` of `leaf` (swap-remove, fixing the moved item's

@@ -160,11 +160,18 @@ impl<T> LinearOctree<T> {
         ControlFlow::Continue(())
     }
 
+    /// Reports an overlapping pair if the objects' filters interact (read
+    /// from the records the payloads come from).
     #[inline]
     fn report<F>(&self, a: Handle, b: Handle, f: &mut F) -> ControlFlow<()>
     where
         F: FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     {
-        f(a, &self.obj(a).value, b, &self.obj(b).value)
+        let (oa, ob) = (self.obj(a), self.obj(b));
+        if oa.filter.interacts(ob.filter) {
+            f(a, &oa.value, b, &ob.value)
+        } else {
+            ControlFlow::Continue(())
+        }
     }
 }

@@ -4,6 +4,7 @@
 
 use super::node::NONE;
 use super::LinearOctree;
+use crate::broad::filter::Admit;
 use crate::broad::Selection;
 use crate::geom::{Frustum, Relation, Sphere};
 use crate::Handle;
@@ -26,40 +27,54 @@ impl<T> LinearOctree<T> {
     /// mask returned for a node is what its children are tested against, so a
     /// frustum plane that contains a parent is never tested again below it.
     /// Recursion depth ≤ 22; no allocation.
-    pub(super) fn visit_tree<Q, F>(&self, q: &Q, f: &mut F) -> ControlFlow<()>
+    ///
+    /// `admit` is `()` for an unfiltered walk (compiled away) or the query's
+    /// filter: then subtrees whose filter bits cannot interact with it are
+    /// skipped, and objects are reported only if their filter interacts.
+    pub(super) fn visit_tree<Q, A, F>(&self, q: &Q, admit: A, f: &mut F) -> ControlFlow<()>
     where
         Q: Selection + ?Sized,
+        A: Admit,
         F: FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     {
         if self.objects.is_empty() {
             return ControlFlow::Continue(());
         }
-        self.visit_node(self.root, [0; 3], 0, Frustum::ALL_PLANES, q, f)
+        self.visit_node(self.root, [0; 3], 0, Frustum::ALL_PLANES, q, admit, f)
     }
 
-    fn visit_node<Q, F>(
+    #[allow(clippy::too_many_arguments)]
+    fn visit_node<Q, A, F>(
         &self,
         i: u32,
         c: [u32; 3],
         d: u32,
         mask: u8,
         q: &Q,
+        admit: A,
         f: &mut F,
     ) -> ControlFlow<()>
     where
         Q: Selection + ?Sized,
+        A: Admit,
         F: FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     {
         let n = &self.nodes[i];
+        if !admit.node(n.groups, n.masks) {
+            return ControlFlow::Continue(());
+        }
         let (rel, mask) = q.classify_box(&self.loose_of(c, d, n.max_extent), mask);
         match rel {
             Relation::Outside => ControlFlow::Continue(()),
-            Relation::Inside => self.report_all(i, f),
+            Relation::Inside => self.report_all(i, admit, f),
             Relation::Intersecting => {
                 if n.leaf {
                     for it in &n.items {
                         if q.selects(&it.sphere) {
-                            f(it.handle, &it.sphere, &self.obj(it.handle).value)?;
+                            let o = self.obj(it.handle);
+                            if admit.object(o.filter) {
+                                f(it.handle, &it.sphere, &o.value)?;
+                            }
                         }
                     }
                 } else {
@@ -76,7 +91,7 @@ impl<T> LinearOctree<T> {
                         if q.classify_box(&outer, mask).0 == Relation::Outside {
                             continue;
                         }
-                        self.visit_node(ch, cc, d + 1, mask, q, f)?;
+                        self.visit_node(ch, cc, d + 1, mask, q, admit, f)?;
                     }
                 }
                 ControlFlow::Continue(())
@@ -86,19 +101,26 @@ impl<T> LinearOctree<T> {
 
     /// Reports every object below node `i` without testing (its loose box is
     /// inside the query).
-    fn report_all<F>(&self, i: u32, f: &mut F) -> ControlFlow<()>
+    fn report_all<A, F>(&self, i: u32, admit: A, f: &mut F) -> ControlFlow<()>
     where
+        A: Admit,
         F: FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     {
         let n = &self.nodes[i];
+        if !admit.node(n.groups, n.masks) {
+            return ControlFlow::Continue(());
+        }
         if n.leaf {
             for it in &n.items {
-                f(it.handle, &it.sphere, &self.obj(it.handle).value)?;
+                let o = self.obj(it.handle);
+                if admit.object(o.filter) {
+                    f(it.handle, &it.sphere, &o.value)?;
+                }
             }
         } else {
             for &ch in &n.children {
                 if ch != NONE {
-                    self.report_all(ch, f)?;
+                    self.report_all(ch, admit, f)?;
                 }
             }
         }

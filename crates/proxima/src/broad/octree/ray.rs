@@ -1,43 +1,63 @@
-//! First hit along a ray: front-to-back traversal of the loose boxes, pruning
-//! every subtree the ray enters after the best hit found so far.
+//! First hit along a ray or a sphere sweep: front-to-back traversal of the
+//! loose boxes, pruning every subtree the cast enters after the best hit found
+//! so far.
 
 use super::node::NONE;
 use super::query::child_coords;
 use super::LinearOctree;
-use crate::broad::RayHit;
-use crate::geom::{overlap, Ray};
+use crate::broad::walk::Cast;
+use crate::broad::{Filter, RayHit};
 
 /// A subtree is skipped only when its box entry `t0` exceeds the best hit by more
 /// than this relative margin: the box and sphere entry parameters are rounded
-/// differently, and a pruned subtree must never hold the true first hit.
+/// differently (and the loose box is checked to contain the sphere's rounded
+/// box, not the exact ball), and a pruned subtree must never hold the true
+/// first hit.
 const PRUNE_MARGIN: f32 = 1e-4;
 
 impl<T> LinearOctree<T> {
-    /// The hit with the smallest `(t, handle)`; children are visited in order of
-    /// their loose boxes' entry parameter. No allocation (≤ 8 children sorted on
-    /// the stack per level).
-    pub(super) fn ray_first_tree(&self, ray: &Ray) -> Option<RayHit> {
+    /// The contact of a ray or sweep with the smallest `(t, handle)`; children
+    /// are visited in order of their loose boxes' entry bound
+    /// ([`Cast::enter`]). No allocation (≤ 8 children sorted on the stack per
+    /// level). Objects whose filter does not interact with `filter` are
+    /// skipped at the candidate.
+    pub(super) fn first_tree<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best = None;
         if !self.objects.is_empty() {
             let n = &self.nodes[self.root];
-            if let Some((t0, _)) = overlap::ray_aabb(ray, &self.loose_of([0; 3], 0, n.max_extent)) {
-                self.ray_node(self.root, [0; 3], 0, t0, ray, &mut best);
+            if let Some(t0) = cast.enter(&self.loose_of([0; 3], 0, n.max_extent)) {
+                self.first_node(self.root, [0; 3], 0, t0, cast, filter, &mut best);
             }
         }
         best
     }
 
-    fn ray_node(&self, i: u32, c: [u32; 3], d: u32, t0: f32, ray: &Ray, best: &mut Option<RayHit>) {
+    #[allow(clippy::too_many_arguments)]
+    fn first_node<C: Cast>(
+        &self,
+        i: u32,
+        c: [u32; 3],
+        d: u32,
+        t0: f32,
+        cast: &C,
+        filter: Option<Filter>,
+        best: &mut Option<RayHit>,
+    ) {
         if let Some(b) = best {
             if t0 > b.t + PRUNE_MARGIN * (b.t.abs() + 1.0) {
                 return;
             }
         }
         let n = &self.nodes[i];
+        if filter.is_some_and(|f| !f.may_interact(n.groups, n.masks)) {
+            return;
+        }
         if n.leaf {
             for it in &n.items {
-                if let Some(t) = overlap::ray_sphere(ray, &it.sphere) {
-                    RayHit::offer(best, t, it.handle);
+                if let Some(t) = cast.contact(&it.sphere) {
+                    if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
+                        RayHit::offer(best, t, it.handle);
+                    }
                 }
             }
             return;
@@ -50,14 +70,14 @@ impl<T> LinearOctree<T> {
             }
             let cc = child_coords(c, k);
             let loose = self.loose_of(cc, d + 1, self.nodes[ch].max_extent);
-            if let Some((ct0, _)) = overlap::ray_aabb(ray, &loose) {
+            if let Some(ct0) = cast.enter(&loose) {
                 order[m] = (ct0, ch, cc);
                 m += 1;
             }
         }
         order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         for &(ct0, ch, cc) in &order[..m] {
-            self.ray_node(ch, cc, d + 1, ct0, ray, best);
+            self.first_node(ch, cc, d + 1, ct0, cast, filter, best);
         }
     }
 }

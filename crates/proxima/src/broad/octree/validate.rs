@@ -145,6 +145,10 @@ impl<T> LinearOctree<T> {
                 if !le(it.ext, n.max_extent) {
                     return fail(format!("max_extent of leaf {:?} too small", n.code));
                 }
+                // Filtered walks skip a node on its filter bits.
+                if o.filter.group & !n.groups != 0 || o.filter.mask & !n.masks != 0 {
+                    return fail(format!("filter bits of leaf {:?} miss an object's", n.code));
+                }
                 if !loose.contains_aabb(&o.sphere.aabb()) {
                     return fail(format!(
                         "sphere {:?} outside loose box of {:?}",
@@ -168,6 +172,10 @@ impl<T> LinearOctree<T> {
                 }
                 if self.nodes[ch].parent != i {
                     return fail(format!("child of {:?} has a wrong parent", n.code));
+                }
+                let cn = &self.nodes[ch];
+                if cn.groups & !n.groups != 0 || cn.masks & !n.masks != 0 {
+                    return fail(format!("filter bits of {:?} miss a child's", n.code));
                 }
                 let s = self.check_node(ch, child_coords(c, k), d + 1, per_depth)?;
                 if !le(s.max_ext, n.max_extent) || !le(self.nodes[ch].max_extent, n.max_extent) {

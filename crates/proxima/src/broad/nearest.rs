@@ -1,0 +1,312 @@
+//! k nearest neighbours [sources: index-queries]: the query ([`Nearest`]), its
+//! answer ([`Neighbor`]), the distances ([`Metric`]), and the reference search
+//! every index starts from (an expanding sphere query), which the indices with
+//! a better search override.
+
+use super::walk::Walk;
+use super::Filter;
+use crate::error::check_vec3;
+use crate::geom::{overlap, Aabb, Sphere};
+use crate::{Error, Handle, Result};
+use glam::Vec3;
+use std::ops::ControlFlow;
+
+/// How [`Nearest`] measures the distance from its point to a stored sphere.
+/// Both are [`overlap::point_sphere_distance`], correctly rounded to `f32`, so
+/// every index reports the same value for the same object (bit for bit) and
+/// breaks ties the same way (smaller handle first).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Metric {
+    /// To the sphere's surface, `max(0, |c - q| - r)` (`0` inside): the
+    /// default, what "the nearest object" means for objects with extent.
+    #[default]
+    Surface,
+    /// To the sphere's centre, `|c - q|`: for point clouds (with radius-0
+    /// spheres the two metrics are equal).
+    Center,
+}
+
+impl Metric {
+    /// The distance from `point` to `s` in this metric (correctly rounded).
+    /// O(1).
+    #[inline]
+    pub fn distance(self, point: Vec3, s: &Sphere) -> f32 {
+        match self {
+            Metric::Surface => overlap::point_sphere_distance(point, s),
+            Metric::Center => overlap::point_sphere_distance(point, &Sphere::new(s.center, 0.0)),
+        }
+    }
+}
+
+/// A k-nearest-neighbours query: the (up to) `k` stored objects nearest to
+/// `point`, at most `max_distance` away, in `metric`. Build it with
+/// [`Nearest::new`] and refine with [`Nearest::within`] and
+/// [`Nearest::metric`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Nearest {
+    /// Where distances are measured from.
+    pub point: Vec3,
+    /// How many objects at most (`0` gives none).
+    pub k: usize,
+    /// Objects farther than this are left out (inclusive: an object exactly
+    /// this far counts). `f32::INFINITY` (the default) for no limit.
+    pub max_distance: f32,
+    /// The distance used, for ranking and for `max_distance`.
+    pub metric: Metric,
+}
+
+impl Nearest {
+    /// The `k` objects nearest to `point` by surface distance, with no limit.
+    pub const fn new(point: Vec3, k: usize) -> Self {
+        Nearest {
+            point,
+            k,
+            max_distance: f32::INFINITY,
+            metric: Metric::Surface,
+        }
+    }
+
+    /// The same query limited to objects at most `max_distance` away.
+    pub const fn within(self, max_distance: f32) -> Self {
+        Nearest {
+            max_distance,
+            ..self
+        }
+    }
+
+    /// The same query in another metric.
+    pub const fn metric(self, metric: Metric) -> Self {
+        Nearest { metric, ..self }
+    }
+
+    /// Checks for a finite point and a `max_distance` that is not NaN or
+    /// negative (`∞` is fine). O(1).
+    pub fn validate(&self) -> Result<()> {
+        check_vec3(self.point, "nearest point")?;
+        if self.max_distance.is_nan() {
+            return Err(Error::NonFinite {
+                what: "nearest max_distance",
+            });
+        }
+        if self.max_distance < 0.0 {
+            return Err(Error::InvalidParameter(format!(
+                "nearest max_distance must be >= 0, got {}",
+                self.max_distance
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One answer of a [`Nearest`] query.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Neighbor {
+    /// The object.
+    pub handle: Handle,
+    /// Its distance from the query point in the query's metric.
+    pub distance: f32,
+}
+
+impl Neighbor {
+    /// The order of a [`Nearest`] answer: smaller distance first, ties by the
+    /// smaller handle. A total order (distances are never NaN).
+    #[inline]
+    pub fn order(a: &Neighbor, b: &Neighbor) -> std::cmp::Ordering {
+        a.distance
+            .total_cmp(&b.distance)
+            .then(a.handle.cmp(&b.handle))
+    }
+}
+
+/// Sorts the candidates in `out` into the answer order and keeps the first
+/// `k`. O(n + k log k).
+pub(crate) fn finish(out: &mut Vec<Neighbor>, k: usize) {
+    if out.len() > k {
+        out.select_nth_unstable_by(k, Neighbor::order);
+        out.truncate(k);
+    }
+    out.sort_unstable_by(Neighbor::order);
+}
+
+/// The `k` best candidates seen so far, kept as a max-heap (worst first, in
+/// [`Neighbor::order`]) inside the caller's output buffer: the bounded heap of
+/// the best-first and branch-and-bound searches. No allocation once the buffer
+/// holds `k` entries.
+pub(crate) struct KBest<'a> {
+    heap: &'a mut Vec<Neighbor>,
+    k: usize,
+    limit: f32,
+}
+
+impl<'a> KBest<'a> {
+    /// An empty heap in `out` (cleared) for the `k` best within `limit`.
+    pub(crate) fn new(out: &'a mut Vec<Neighbor>, k: usize, limit: f32) -> Self {
+        out.clear();
+        KBest {
+            heap: out,
+            k,
+            limit,
+        }
+    }
+
+    /// The largest distance a candidate may have and still enter: the limit
+    /// until `k` are held, then the worst held distance (a candidate at exactly
+    /// that distance may still enter with a smaller handle, so searches prune
+    /// only what lies strictly beyond it).
+    #[inline]
+    pub(crate) fn bound(&self) -> f32 {
+        if self.heap.len() < self.k {
+            self.limit
+        } else {
+            self.heap[0].distance
+        }
+    }
+
+    /// Offers a candidate: kept if fewer than `k` are held or it precedes the
+    /// worst held one. O(log k).
+    #[inline]
+    pub(crate) fn offer(&mut self, n: Neighbor) {
+        if n.distance > self.limit || self.k == 0 {
+            return;
+        }
+        let h = &mut *self.heap;
+        if h.len() < self.k {
+            h.push(n);
+            let mut i = h.len() - 1;
+            while i > 0 {
+                let p = (i - 1) / 2;
+                if Neighbor::order(&h[p], &h[i]).is_lt() {
+                    h.swap(p, i);
+                    i = p;
+                } else {
+                    break;
+                }
+            }
+        } else if Neighbor::order(&n, &h[0]).is_lt() {
+            h[0] = n;
+            let mut i = 0;
+            loop {
+                let (l, r) = (2 * i + 1, 2 * i + 2);
+                let mut m = i;
+                if l < h.len() && Neighbor::order(&h[m], &h[l]).is_lt() {
+                    m = l;
+                }
+                if r < h.len() && Neighbor::order(&h[m], &h[r]).is_lt() {
+                    m = r;
+                }
+                if m == i {
+                    break;
+                }
+                h.swap(i, m);
+                i = m;
+            }
+        }
+    }
+
+    /// Puts the held candidates in answer order. O(k log k).
+    pub(crate) fn finish(self) {
+        self.heap.sort_unstable_by(Neighbor::order);
+    }
+}
+
+/// Radius of the first sphere query: small, so that a dense neighbourhood
+/// costs few candidates; it grows geometrically from there.
+const FIRST_RADIUS: f32 = 1.0 / 1024.0;
+
+/// Beyond this radius the search stops growing and scans every object (the
+/// sphere's `f32` radius must stay finite, and queries this wide select most
+/// of an index anyway).
+const SCAN_RADIUS: f32 = 1e30;
+
+/// A box containing every finite sphere's centre: a sphere query for it
+/// selects every stored object.
+const EVERYTHING: Aabb = Aabb {
+    min: Vec3::splat(-f32::MAX),
+    max: Vec3::splat(f32::MAX),
+};
+
+/// The reference k-nearest search, correct for every index: sphere queries of
+/// growing radius `r` around the point until one proves that the `k` nearest
+/// are among what it selected, then a sort of those candidates.
+///
+/// Why it is exact: the query selects, exactly, every object whose surface
+/// distance is at most `next_up(r)`; distances are correctly rounded, hence
+/// monotone, so an object whose (rounded) distance is at most `r` in either
+/// metric is selected (its exact distance is below `r`'s upper rounding
+/// midpoint, less than `next_up(r)`, and the surface distance is at most the
+/// centre distance). The search stops when (a) at least `k` candidates are at
+/// most `r` away: the `k`-th smallest distance `D` is then at most `r`, so
+/// every object at most `D` away is a candidate and ties at `D` are all seen;
+/// (b) `r >= max_distance`: every object within the limit is a candidate;
+/// (c) the query selected every object; or (d) `r` passed [`SCAN_RADIUS`],
+/// when one scan of everything decides. The filter is applied to candidates.
+///
+/// Cost: O(rounds × sphere query) with `r` growing 2–8× per round from
+/// [`FIRST_RADIUS`], plus a selection over the candidates; `out` is the only
+/// buffer (no allocation once it has grown).
+pub(crate) fn expanding<T, I: Walk<T> + ?Sized>(
+    index: &I,
+    q: &Nearest,
+    filter: Option<Filter>,
+    out: &mut Vec<Neighbor>,
+) {
+    out.clear();
+    let n = index.object_count();
+    if q.k == 0 || n == 0 {
+        return;
+    }
+    let keep = |h: Handle| filter.map_or(true, |f| f.interacts(index.filter_of(h)));
+    let mut r = FIRST_RADIUS.min(q.max_distance);
+    loop {
+        if r > SCAN_RADIUS {
+            out.clear();
+            let _ = index.walk(&EVERYTHING, |h, s, _| {
+                if keep(h) {
+                    let distance = q.metric.distance(q.point, s);
+                    if distance <= q.max_distance {
+                        out.push(Neighbor {
+                            handle: h,
+                            distance,
+                        });
+                    }
+                }
+                ControlFlow::Continue(())
+            });
+            break;
+        }
+        out.clear();
+        let (mut seen, mut close) = (0usize, 0usize);
+        let reach = Sphere::new(q.point, next_up(r));
+        let _ = index.walk(&reach, |h, s, _| {
+            seen += 1;
+            if keep(h) {
+                let distance = q.metric.distance(q.point, s);
+                if distance <= q.max_distance {
+                    out.push(Neighbor {
+                        handle: h,
+                        distance,
+                    });
+                    close += (distance <= r) as usize;
+                }
+            }
+            ControlFlow::Continue(())
+        });
+        if close >= q.k || r >= q.max_distance || seen >= n {
+            break;
+        }
+        r = (r * if close == 0 { 8.0 } else { 2.0 }).min(q.max_distance.max(r));
+        // A limit just above `r` may be reached exactly: the next round ends.
+    }
+    finish(out, q.k);
+}
+
+/// The next `f32` up (`f32::next_up` needs Rust 1.86; the MSRV is 1.80). For
+/// finite non-negative `x`.
+#[inline]
+fn next_up(x: f32) -> f32 {
+    if x == 0.0 {
+        f32::from_bits(1)
+    } else {
+        f32::from_bits(x.to_bits() + 1)
+    }
+}

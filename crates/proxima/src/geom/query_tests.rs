@@ -1,0 +1,395 @@
+//! Tests of the sweep and distance functions of `overlap` against exact
+//! arithmetic written independently here (expansions straight from the end
+//! points, not through `line_ball`'s formulation).
+
+use super::*;
+use crate::geom::exact::{self, Exp};
+use crate::geom::Segment;
+use glam::vec3;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+/// A random `f32` on a coarse grid (exact ties are common) at one of several
+/// magnitudes, mixed within one case.
+fn coarse(rng: &mut Pcg64) -> f32 {
+    let scale = [1.0f32, 1.0 / 64.0, 1e-20, 1e15, 1e30][rng.gen_range(0..5)];
+    rng.gen_range(-8i32..=8) as f32 * scale
+}
+
+fn cv(rng: &mut Pcg64) -> Vec3 {
+    vec3(coarse(rng), coarse(rng), coarse(rng))
+}
+
+fn ex(v: Vec3) -> [f64; 3] {
+    [v.x as f64, v.y as f64, v.z as f64]
+}
+
+fn edot(a: &[Exp; 3], b: &[Exp; 3]) -> Exp {
+    a[0].mul(&b[0]).add(&a[1].mul(&b[1])).add(&a[2].mul(&b[2]))
+}
+
+fn ediff(a: Vec3, b: Vec3) -> [Exp; 3] {
+    let (a, b) = (ex(a), ex(b));
+    [0, 1, 2].map(|i| Exp::diff(a[i], b[i]))
+}
+
+/// Exactly: does the sweep touch the sphere? From the end points: touching at
+/// the start or the end, or the closest point of the open segment within
+/// `r + R` (its foot strictly between the ends: `(f - c)·(t - f) < 0` and
+/// `(t - c)·(t - f) > 0`, then `|(f - c) × (t - c)|² <= ρ² |t - f|²`).
+fn sweep_touches_exact(sw: &SphereSweep, s: &Sphere) -> bool {
+    let rho = Exp::diff(s.radius as f64, -(sw.radius as f64));
+    let rho2 = rho.mul(&rho);
+    let within = |p: Vec3| {
+        let d = ediff(p, s.center);
+        rho2.sub(&edot(&d, &d)).sign() != Ordering::Less
+    };
+    if within(sw.from) || within(sw.to) {
+        return true;
+    }
+    let (fc, tc, tf) = (
+        ediff(sw.from, s.center),
+        ediff(sw.to, s.center),
+        ediff(sw.to, sw.from),
+    );
+    if edot(&fc, &tf).sign() != Ordering::Less || edot(&tc, &tf).sign() != Ordering::Greater {
+        return false;
+    }
+    let cr = [
+        fc[1].mul(&tc[2]).sub(&fc[2].mul(&tc[1])),
+        fc[2].mul(&tc[0]).sub(&fc[0].mul(&tc[2])),
+        fc[0].mul(&tc[1]).sub(&fc[1].mul(&tc[0])),
+    ];
+    rho2.mul(&edot(&tf, &tf)).sub(&edot(&cr, &cr)).sign() != Ordering::Less
+}
+
+/// Hit or miss of `sweep_sphere` is exact at every magnitude (from 1e-20 to
+/// 1e30, exact ties common), zero-length sweeps included; a hit's `t` is in
+/// `[0, 1]`, `0` iff it touches at the start; and every box containing the
+/// sphere is met by `sweep_aabb` with `t0 <= t <= t1` (index pruning is
+/// consistent with the reported time).
+#[test]
+fn sweep_sphere_exact_and_consistent() {
+    let mut rng = Pcg64::seed_from_u64(21);
+    let (mut hits, mut misses, mut zero_len, mut at_start) = (0, 0, 0, 0);
+    for k in 0..200_000 {
+        let from = cv(&mut rng);
+        let to = if k % 10 == 0 { from } else { cv(&mut rng) };
+        let sw = SphereSweep::new(from, to, coarse(&mut rng).abs());
+        let s = Sphere::new(cv(&mut rng), coarse(&mut rng).abs());
+        let got = sweep_sphere(&sw, &s);
+        assert_eq!(got.is_some(), sweep_touches_exact(&sw, &s), "{sw:?} {s:?}");
+        let start = exact::within(ex(from), ex(s.center), s.radius as f64, sw.radius as f64);
+        zero_len += (from == to) as u32;
+        let Some(t) = got else {
+            misses += 1;
+            continue;
+        };
+        hits += 1;
+        assert!((0.0..=1.0).contains(&t), "{t} {sw:?} {s:?}");
+        if start {
+            assert_eq!(t, 0.0);
+            at_start += 1;
+        }
+        if from == to {
+            assert!(start, "a zero-length sweep touches only at the start");
+        }
+        let b = outward_box(&s);
+        for _ in 0..3 {
+            let mut grow = || [0.0, 1.0, 1e10, 1e30][rng.gen_range(0..4)];
+            let bx = Aabb::new(
+                b.min - vec3(grow(), grow(), grow()),
+                b.max + vec3(grow(), grow(), grow()),
+            );
+            let (t0, t1) = sweep_aabb(&sw, &bx).expect("box pruned a touched sphere");
+            assert!(t0 <= t && t <= t1, "{t0} {t} {t1} {sw:?} {s:?}");
+        }
+    }
+    assert!(hits > 20_000 && misses > 20_000, "{hits} {misses}");
+    assert!(
+        zero_len > 10_000 && at_start > 5_000,
+        "{zero_len} {at_start}"
+    );
+}
+
+/// Near-tangent sweeps at random orientations and magnitudes: the exact answer
+/// flips within a few ulps, and the test follows it.
+#[test]
+fn grazing_sweeps_are_exact() {
+    let mut rng = Pcg64::seed_from_u64(22);
+    let mut both = [0u32; 2];
+    for k in 0..50_000 {
+        let scale = [1e-3f32, 1.0, 1e4, 1e20][k % 4];
+        let mut u = || rng.gen_range(-1.0f32..1.0);
+        let c = vec3(u(), u(), u()) * scale;
+        let dir = vec3(u(), u(), u()).normalize_or(Vec3::X);
+        let side = dir.any_orthonormal_vector();
+        let (r, rr) = (u().abs() * scale, u().abs() * scale);
+        // The segment passes at distance (r + R)(1 + tiny) from the centre.
+        let off = (r + rr) * (1.0 + u() * 1e-6);
+        let mid = c + side * off;
+        let half = dir * scale * (0.5 + u().abs());
+        let sw = SphereSweep::new(mid - half, mid + half, rr);
+        let s = Sphere::new(c, r);
+        let got = sweep_sphere(&sw, &s).is_some();
+        assert_eq!(got, sweep_touches_exact(&sw, &s), "{sw:?} {s:?}");
+        both[got as usize] += 1;
+    }
+    assert!(both.iter().all(|&n| n > 5_000), "{both:?}");
+}
+
+/// Tangent cases with exact answers: a sweep grazing a sphere touches it, and
+/// one ulp less radius misses; at the end point too.
+#[test]
+fn tangent_sweeps_touch_and_one_ulp_less_misses() {
+    let s = Sphere::new(vec3(0.0, 5.0, 0.0), 3.0);
+    let graze = SphereSweep::new(vec3(-10.0, 0.0, 0.0), vec3(10.0, 0.0, 0.0), 2.0);
+    assert_eq!(sweep_sphere(&graze, &s), Some(0.5));
+    let thinner = SphereSweep {
+        radius: exact::f32_down(2.0),
+        ..graze
+    };
+    assert_eq!(sweep_sphere(&thinner, &s), None);
+    // 3-4-5 at the end point: the sweep stops exactly touching.
+    let s2 = Sphere::new(vec3(13.0, 4.0, 0.0), 2.0);
+    let to_touch = SphereSweep::new(vec3(-10.0, 0.0, 0.0), vec3(10.0, 0.0, 0.0), 3.0);
+    assert_eq!(sweep_sphere(&to_touch, &s2), Some(1.0));
+    let short = SphereSweep::new(
+        vec3(-10.0, 0.0, 0.0),
+        vec3(exact::f32_down(10.0), 0.0, 0.0),
+        3.0,
+    );
+    assert_eq!(sweep_sphere(&short, &s2), None);
+    // Starting inside (and touching at the start) is t = 0.
+    let inside = SphereSweep::new(vec3(0.0, 1.0, 0.0), vec3(0.0, -100.0, 0.0), 1.5);
+    assert_eq!(sweep_sphere(&inside, &s), Some(0.0));
+    let touching = SphereSweep::new(vec3(0.0, 0.0, 0.0), vec3(0.0, -100.0, 0.0), 2.0);
+    assert_eq!(sweep_sphere(&touching, &s), Some(0.0));
+    // Moving away from a sphere it does not touch.
+    let away = SphereSweep::new(vec3(0.0, 0.0, 0.0), vec3(0.0, -100.0, 0.0), 1.0);
+    assert_eq!(sweep_sphere(&away, &s), None);
+    // Zero length: touches iff it overlaps.
+    let rest = SphereSweep::new(vec3(0.0, 1.0, 0.0), vec3(0.0, 1.0, 0.0), 1.0);
+    assert_eq!(sweep_sphere(&rest, &s), Some(0.0));
+    let rest_far = SphereSweep::new(Vec3::ZERO, Vec3::ZERO, 1.0);
+    assert_eq!(sweep_sphere(&rest_far, &s), None);
+    assert!(sweep_aabb(&rest, &s.aabb()).is_some());
+    // Head on: first contact when the centres are r + R apart.
+    let head_on = SphereSweep::new(vec3(0.0, -5.0, 0.0), vec3(0.0, 15.0, 0.0), 2.0);
+    assert_eq!(sweep_sphere(&head_on, &s), Some(0.25));
+}
+
+/// The radius is the exact sum `r + R` and the direction the exact difference:
+/// inputs whose `f32` sum or difference would round the wrong way are decided
+/// right.
+#[test]
+fn sweep_does_not_round_its_inputs() {
+    // r + R = 1 + 2^-30 is not an f32; the sphere is touched only through the
+    // exact sum.
+    let r = 1.0f32;
+    let rr = 2f32.powi(-30);
+    let s = Sphere::new(vec3(0.0, 1.0 + 2f32.powi(-23), 0.0), r);
+    let sw = SphereSweep::new(vec3(-1.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), rr);
+    assert_eq!(sweep_sphere(&sw, &s), None, "gap 2^-23 > 2^-30");
+    let s_touch = Sphere::new(vec3(0.0, 1.0, 0.0), r);
+    assert!(sweep_sphere(&sw, &s_touch).is_some());
+    // A direction that is not an f32: from 1e-30 to 1 (to - from rounds to 1).
+    // The segment ends at 1, so a sphere touching x = 1 exactly counts, and
+    // one an ulp beyond does not.
+    let sw = SphereSweep::new(vec3(1e-30, 0.0, 0.0), vec3(1.0, 0.0, 0.0), 0.0);
+    let at_end = Sphere::new(vec3(2.0, 0.0, 0.0), 1.0);
+    assert_eq!(sweep_sphere(&sw, &at_end), Some(1.0));
+    let beyond = Sphere::new(vec3(2.0, 0.0, 0.0), exact::f32_down(1.0));
+    assert_eq!(sweep_sphere(&sw, &beyond), None);
+    let (t0, t1) = sweep_aabb(&sw, &at_end.aabb()).expect("touching box");
+    assert!(t0 <= 1.0 && t1 == 1.0, "{t0} {t1}");
+}
+
+/// A radius-0 sweep is the segment query whenever `to - from` is an `f32`:
+/// the same hits with bit-identical times, and the same box intervals.
+#[test]
+fn radius_zero_sweep_is_the_segment_query() {
+    let mut rng = Pcg64::seed_from_u64(23);
+    let mut hits = 0;
+    for k in 0..100_000 {
+        let mut g = || rng.gen_range(-64i32..=64) as f32 * [1.0, 0.25, 1024.0][k % 3];
+        let (from, to) = (vec3(g(), g(), g()), vec3(g(), g(), g()));
+        if from == to {
+            continue;
+        }
+        let s = Sphere::new(vec3(g(), g(), g()), g().abs());
+        let sw = SphereSweep::new(from, to, 0.0);
+        let seg = Segment::new(from, to).to_ray();
+        assert_eq!(sweep_sphere(&sw, &s), ray_sphere(&seg, &s), "{sw:?} {s:?}");
+        let b = Aabb::new(vec3(g(), g(), g()), vec3(g(), g(), g()));
+        let b = Aabb::new(b.min.min(b.max), b.min.max(b.max));
+        assert_eq!(sweep_aabb(&sw, &b), ray_aabb(&seg, &b), "{sw:?} {b:?}");
+        hits += sweep_sphere(&sw, &s).is_some() as u32;
+    }
+    assert!(hits > 5_000, "{hits}");
+}
+
+/// The times are accurate: for hits that do not start inside, the true first
+/// contact (solved in `f64` where well-conditioned) is within 1e-5.
+#[test]
+fn sweep_times_are_accurate() {
+    let mut rng = Pcg64::seed_from_u64(24);
+    let mut checked = 0;
+    for _ in 0..50_000 {
+        let mut u = || rng.gen_range(-50.0f32..50.0);
+        let sw = SphereSweep::new(vec3(u(), u(), u()), vec3(u(), u(), u()), u().abs() * 0.1);
+        let s = Sphere::new(vec3(u(), u(), u()), u().abs() * 0.3);
+        let Some(t) = sweep_sphere(&sw, &s) else {
+            continue;
+        };
+        let (f, e, c) = (ex(sw.from), ex(sw.to), ex(s.center));
+        let d = [0, 1, 2].map(|i| e[i] - f[i]);
+        let m = [0, 1, 2].map(|i| f[i] - c[i]);
+        let rho = s.radius as f64 + sw.radius as f64;
+        let (a, b, cc) = (dot(d, d), dot(m, d), dot(m, m) - rho * rho);
+        if cc <= 0.0 {
+            assert_eq!(t, 0.0);
+            continue;
+        }
+        let disc = b * b - a * cc;
+        // Well-conditioned roots only (not grazing).
+        if disc < 1e-3 * b * b {
+            continue;
+        }
+        let want = (-b - disc.sqrt()) / a;
+        assert!((t as f64 - want).abs() < 1e-5, "{t} {want} {sw:?} {s:?}");
+        checked += 1;
+    }
+    assert!(checked > 1000, "{checked}");
+}
+
+/// Sign of `|a - c| - r - m`, from expansions written here (the reference for
+/// the rounding of `point_sphere_distance`).
+fn cmp_exact(p: Vec3, s: &Sphere, m: f64) -> Ordering {
+    let rm = Exp::diff(s.radius as f64, -m);
+    if rm.sign() == Ordering::Less {
+        return Ordering::Greater;
+    }
+    let d = ediff(p, s.center);
+    edot(&d, &d).sub(&rm.mul(&rm)).sign()
+}
+
+/// `y` is the correctly rounded `max(0, |c - p| - r)` (ties to even), checked
+/// with exact comparisons against the midpoints around `y`.
+fn assert_correctly_rounded(p: Vec3, s: &Sphere, y: f32) {
+    assert!(y >= 0.0, "{p} {s:?} -> {y}");
+    let even = y.to_bits() & 1 == 0;
+    let yd = y as f64;
+    if y > 0.0 {
+        let lo = (yd + exact::f32_down(y) as f64) * 0.5;
+        let c = cmp_exact(p, s, lo);
+        assert!(
+            c == Ordering::Greater || (c == Ordering::Equal && even),
+            "{p} {s:?} -> {y}: below its interval"
+        );
+    }
+    if y.is_finite() {
+        let next = if y == f32::MAX {
+            2f64.powi(128)
+        } else {
+            -exact::f32_down(-y) as f64
+        };
+        let hi = (yd + next) * 0.5;
+        let c = cmp_exact(p, s, hi);
+        assert!(
+            c == Ordering::Less || (c == Ordering::Equal && even),
+            "{p} {s:?} -> {y}: above its interval"
+        );
+    }
+}
+
+/// Correct rounding on coarse grids at every magnitude (exact ties and
+/// distances on rounding boundaries are common there) and on random floats.
+#[test]
+fn point_sphere_distance_is_correctly_rounded() {
+    let mut rng = Pcg64::seed_from_u64(25);
+    let mut zeros = 0;
+    for k in 0..200_000 {
+        let (p, s) = if k % 2 == 0 {
+            (
+                cv(&mut rng),
+                Sphere::new(cv(&mut rng), coarse(&mut rng).abs()),
+            )
+        } else {
+            let scale = 10f32.powi(rng.gen_range(-30..30));
+            let mut u = || rng.gen_range(-1.0f32..1.0) * scale;
+            (
+                vec3(u(), u(), u()),
+                Sphere::new(vec3(u(), u(), u()), u().abs()),
+            )
+        };
+        let y = point_sphere_distance(p, &s);
+        assert_correctly_rounded(p, &s, y);
+        zeros += (y == 0.0) as u32;
+        // The centre distance is the same function with radius 0.
+        let yc = point_sphere_distance(p, &Sphere::new(s.center, 0.0));
+        assert_correctly_rounded(p, &Sphere::new(s.center, 0.0), yc);
+        assert!(yc >= y, "centre distance below surface distance");
+    }
+    assert!(zeros > 10_000, "{zeros}");
+}
+
+/// Distances exactly on a rounding boundary round to even; Pythagorean
+/// distances are exact; huge ones round to `f32::MAX` or `∞` as IEEE does.
+#[test]
+fn distance_ties_and_extremes() {
+    // |p - c| - r = 1 + 2^-24: the midpoint of 1 and 1 + 2^-23 -> 1 (even).
+    let s = Sphere::new(Vec3::ZERO, 2f32.powi(-24));
+    let p = vec3(1.0 + 2f32.powi(-23), 0.0, 0.0);
+    assert_eq!(point_sphere_distance(p, &s), 1.0);
+    // 1 + 3·2^-24, the midpoint of 1 + 2^-23 (odd) and 1 + 2^-22 -> the latter.
+    let p = vec3(1.0 + 2f32.powi(-22), 0.0, 0.0);
+    let s = Sphere::new(Vec3::ZERO, 2f32.powi(-24));
+    assert_eq!(point_sphere_distance(p, &s), 1.0 + 2f32.powi(-22));
+    // 3-4-5, 12 away, minus radius 2.
+    let s = Sphere::new(vec3(1.0, 2.0, 3.0), 2.0);
+    assert_eq!(point_sphere_distance(vec3(4.0, 6.0, 15.0), &s), 11.0);
+    assert_eq!(point_sphere_distance(vec3(1.0, 2.0, 4.0), &s), 0.0);
+    assert_eq!(point_sphere_distance(vec3(1.0, 2.0, 5.0), &s), 0.0);
+    // Beyond f32::MAX: ∞ (2√3·MAX); just below the overflow threshold: MAX.
+    let far = Sphere::new(Vec3::splat(-f32::MAX), 0.0);
+    assert_eq!(
+        point_sphere_distance(Vec3::splat(f32::MAX), &far),
+        f32::INFINITY
+    );
+    let s = Sphere::new(vec3(-f32::MAX, 0.0, 0.0), 0.0);
+    assert_eq!(point_sphere_distance(Vec3::ZERO, &s), f32::MAX);
+    // A huge sphere whose surface passes 1 unit from the point.
+    let s = Sphere::new(vec3(1e30, 0.0, 0.0), 1e30);
+    let p = vec3(-1.0, 0.0, 0.0);
+    assert_eq!(point_sphere_distance(p, &s), 1.0);
+    // Subnormal distances.
+    let tiny = f32::from_bits(3);
+    assert_eq!(
+        point_sphere_distance(vec3(tiny, 0.0, 0.0), &Sphere::new(Vec3::ZERO, 0.0)),
+        tiny
+    );
+}
+
+/// `point_aabb_distance` bounds every sphere inside the box from below, for
+/// both metrics, and is 0 inside.
+#[test]
+fn box_distance_bounds_the_spheres_inside() {
+    let mut rng = Pcg64::seed_from_u64(26);
+    for _ in 0..100_000 {
+        let s = Sphere::new(cv(&mut rng), coarse(&mut rng).abs());
+        let p = cv(&mut rng);
+        let b = outward_box(&s);
+        let mut grow = || [0.0, 1.0, 1e10][rng.gen_range(0..3)];
+        let bx = Aabb::new(
+            b.min - vec3(grow(), grow(), grow()),
+            b.max + vec3(grow(), grow(), grow()),
+        );
+        let lb = point_aabb_distance(p, &bx);
+        assert!(lb <= point_sphere_distance(p, &s), "{p} {s:?} {bx:?}");
+        assert!(lb <= point_sphere_distance(p, &Sphere::new(s.center, 0.0)));
+        if bx.contains_point(p) {
+            assert_eq!(lb, 0.0);
+        }
+    }
+}

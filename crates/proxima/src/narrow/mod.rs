@@ -19,6 +19,7 @@
 mod bv;
 mod bvh;
 mod coplanar;
+mod distance;
 pub(crate) mod predicates;
 mod prepared;
 mod ray_triangle;
@@ -30,6 +31,10 @@ pub use bv::{BoundingVolume, Kdop, Kdop14, Kdop18, Kdop26, Obb};
 pub use bvh::{
     check_pose, BuildOptions, Bvh, Collider, Contacts, CostCounters, FirstContact, Mesh, Node,
     RayBvh, RotationUpdate, SplitRule,
+};
+pub use distance::{
+    closest_point_on_triangle, mesh_distance, meshes_within, triangle_distance, ClosestPoint,
+    MeshDistance, NearPair, NearPairs, Proximity, TriangleDistance,
 };
 pub use prepared::PreparedTriangle;
 pub use ray_triangle::{ray_triangle, TriangleHit};

@@ -184,6 +184,45 @@ impl<const K: usize> Kdop<K> {
             self.d[i] <= v && v <= self.d[i + Self::H]
         })
     }
+
+    /// `1 / |axis_i|` for the slabs after the coordinate ones: corner diagonals
+    /// have length √3, edge diagonals √2.
+    #[inline(always)]
+    fn inv_norm(i: usize) -> f32 {
+        if Self::axis_index(i) < 7 {
+            0.577_350_26
+        } else {
+            std::f32::consts::FRAC_1_SQRT_2
+        }
+    }
+
+    /// The distance lower bound of `self` shifted by `m` (a [`BoundingVolume::motion`],
+    /// or no shift) and `o`: the Euclidean gap of the three coordinate slabs (the
+    /// boxes' distance), or the largest gap of another slab divided by its axis'
+    /// length, whichever is larger. Each is a lower bound on the distance of the
+    /// contents. Written as plain loops over the slabs (no NaN-aware `max`, no
+    /// zero shift added) because it runs once per volume pair.
+    #[inline(always)]
+    fn gap(&self, m: Option<&[f32; K]>, o: &Self) -> f32 {
+        let h = Self::H;
+        let g = |i: usize| {
+            let (lo, hi) = match m {
+                Some(m) => (self.d[i] + m[i], self.d[i + h] + m[i + h]),
+                None => (self.d[i], self.d[i + h]),
+            };
+            fmax(o.d[i] - hi, lo - o.d[i + h])
+        };
+        let mut sq = 0.0f32;
+        for i in 0..3 {
+            let x = fmax(g(i), 0.0);
+            sq += x * x;
+        }
+        let mut slab = 0.0f32;
+        for i in 3..h {
+            slab = fmax(slab, g(i) * Self::inv_norm(i));
+        }
+        fmax(sq.sqrt(), slab)
+    }
 }
 
 impl<const K: usize> BoundingVolume for Kdop<K> {
@@ -317,6 +356,16 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
             }
         }
         Some(t0)
+    }
+
+    #[inline]
+    fn distance_lower_bound(&self, m: &Self::Motion, o: &Self) -> f32 {
+        self.gap(Some(&m.d), o)
+    }
+
+    #[inline]
+    fn distance_lower_bound_fixed(&self, o: &Self) -> f32 {
+        self.gap(None, o)
     }
 }
 

@@ -1,6 +1,6 @@
 //! The sphere as a BVH bounding volume.
 
-use super::BoundingVolume;
+use super::{positive, BoundingVolume};
 use crate::geom::{Ray, Sphere};
 use glam::{Affine3A, Vec3, Vec3A};
 
@@ -72,5 +72,17 @@ impl BoundingVolume for Sphere {
         let grown = Sphere::new(self.center, self.radius + slack);
         crate::geom::overlap::ray_sphere(ray, &grown)
             .map(|t| (t - t.abs() * 4.0 * f32::EPSILON).max(0.0))
+    }
+
+    /// Exact up to the slack: the centre distance minus both radii.
+    #[inline]
+    fn distance_lower_bound(&self, m: &Self::Motion, o: &Self) -> f32 {
+        let c = m.0.transform_point3a(Vec3A::from(self.center));
+        positive((c - Vec3A::from(o.center)).length() - self.radius - o.radius - m.1)
+    }
+
+    #[inline]
+    fn distance_lower_bound_fixed(&self, o: &Self) -> f32 {
+        positive(self.center.distance(o.center) - self.radius - o.radius)
     }
 }

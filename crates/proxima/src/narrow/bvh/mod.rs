@@ -29,11 +29,12 @@ mod ray_cast;
 mod ray_tree;
 mod refit;
 mod stack;
-mod traverse;
+pub(crate) mod traverse;
 mod tree;
-mod tri_cache;
+pub(crate) mod tri_cache;
 mod validate;
 
+pub(crate) use collide::pose_deviation;
 pub use collide::{check_pose, Collider, Contacts, CostCounters, FirstContact, RotationUpdate};
 pub use mesh::Mesh;
 pub use options::{BuildOptions, SplitRule};

@@ -56,7 +56,7 @@ pub(crate) struct Lazy<'a, BV> {
 
 impl<BV: BoundingVolume> Lazy<'_, BV> {
     #[inline]
-    fn get(&mut self, i: usize) -> &BV {
+    pub(crate) fn get(&mut self, i: usize) -> &BV {
         if !self.cache.is_set(i) {
             self.updates += 1;
         }

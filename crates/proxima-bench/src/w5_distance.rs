@@ -158,8 +158,7 @@ fn measure<BV: BoundingVolume>(
     };
     // Warm-up: scratch sized, code and data in cache.
     if let Some(p) = poses.first() {
-        q.distance(&ta, p, &tb)
-            .map_err(|e| e.to_string())?;
+        q.distance(&ta, p, &tb).map_err(|e| e.to_string())?;
     }
     for p in poses {
         let (d, t) = args.clock.time(|| q.distance(&ta, p, &tb));

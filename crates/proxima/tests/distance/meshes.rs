@@ -9,7 +9,7 @@ use super::shapes::{cube, degenerate_only, with_degenerate};
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::{Affine3A, Mat3, Vec3};
 use proxima::narrow::{
-    triangle_distance, BoundingVolume, BuildOptions, Bvh, Collider, Kdop14, Kdop18, Kdop26, Obb,
+    triangle_distance, BoundingVolume, BuildOptions, Collider, Kdop14, Kdop18, Kdop26, Mesh, Obb,
     Proximity, RotationUpdate, SplitRule, TriMesh,
 };
 use rand::{Rng, SeedableRng};
@@ -72,8 +72,8 @@ fn check<BV: BoundingVolume>(a: &TriMesh, b: &TriMesh, wants: &[Want]) {
     ];
     for o in builds {
         let (ta, tb) = (
-            Bvh::<BV>::build(a, o).unwrap(),
-            Bvh::<BV>::build(b, o).unwrap(),
+            Mesh::<BV>::from_trimesh(a.clone(), o).unwrap(),
+            Mesh::<BV>::from_trimesh(b.clone(), o).unwrap(),
         );
         let mut col = Collider::<BV>::default();
         for rot in [
@@ -84,7 +84,7 @@ fn check<BV: BoundingVolume>(a: &TriMesh, b: &TriMesh, wants: &[Want]) {
             let mut q = Proximity::<BV>::new(rot);
             for (k, w) in wants.iter().enumerate() {
                 let ctx = format!("{} {:?} {rot:?} pose {k}", BV::NAME, o.split);
-                let got = q.distance((&ta, a), &w.pose, (&tb, b)).unwrap();
+                let got = q.distance(&ta, &w.pose, &tb).unwrap();
                 assert_eq!(got.distance, w.distance, "{ctx}");
                 assert!(w.at.contains(&got.triangles), "{ctx}: {:?}", got.triangles);
                 let (i, j) = got.triangles;
@@ -104,23 +104,18 @@ fn check<BV: BoundingVolume>(a: &TriMesh, b: &TriMesh, wants: &[Want]) {
                 assert!((p.distance(r) - got.distance).abs() <= w.tol, "{ctx}");
                 assert!(got.counters.np > 0 && got.counters.nv > 0, "{ctx}");
                 // Contact iff the collider finds one.
-                let hit = col.first_contact((&ta, a), &w.pose, (&tb, b)).unwrap();
+                let hit = col.first_contact(&ta, &w.pose, &tb).unwrap();
                 assert_eq!(hit.pair.is_some(), w.distance == 0.0, "{ctx}");
                 // `within` agrees with the distance on both sides of it.
                 let d = w.distance;
-                assert!(q.within((&ta, a), &w.pose, (&tb, b), d).unwrap(), "{ctx}");
-                assert!(q
-                    .within((&ta, a), &w.pose, (&tb, b), d * 2.0 + 1.0)
-                    .unwrap());
+                assert!(q.within(&ta, &w.pose, &tb, d).unwrap(), "{ctx}");
+                assert!(q.within(&ta, &w.pose, &tb, d * 2.0 + 1.0).unwrap());
                 if d > 0.0 {
-                    assert!(
-                        !q.within((&ta, a), &w.pose, (&tb, b), below(d)).unwrap(),
-                        "{ctx}"
-                    );
-                    assert!(!q.within((&ta, a), &w.pose, (&tb, b), d * 0.5).unwrap());
+                    assert!(!q.within(&ta, &w.pose, &tb, below(d)).unwrap(), "{ctx}");
+                    assert!(!q.within(&ta, &w.pose, &tb, d * 0.5).unwrap());
                 }
                 if let Some((m, pairs)) = &w.margin {
-                    let near = q.pairs_within((&ta, a), &w.pose, (&tb, b), *m).unwrap();
+                    let near = q.pairs_within(&ta, &w.pose, &tb, *m).unwrap();
                     let mut got: Vec<(u32, u32)> = near.pairs.iter().map(|p| p.triangles).collect();
                     got.sort_unstable();
                     assert_eq!(&got, pairs, "{ctx}: pairs within {m}");
@@ -131,14 +126,14 @@ fn check<BV: BoundingVolume>(a: &TriMesh, b: &TriMesh, wants: &[Want]) {
                     }
                     // Margin 0: exactly the collider's pairs.
                     let mut zero: Vec<(u32, u32)> = q
-                        .pairs_within((&ta, a), &w.pose, (&tb, b), 0.0)
+                        .pairs_within(&ta, &w.pose, &tb, 0.0)
                         .unwrap()
                         .pairs
                         .iter()
                         .map(|p| p.triangles)
                         .collect();
                     zero.sort_unstable();
-                    let mut all = col.all_pairs((&ta, a), &w.pose, (&tb, b)).unwrap().pairs;
+                    let mut all = col.all_pairs(&ta, &w.pose, &tb).unwrap().pairs;
                     all.sort_unstable();
                     assert_eq!(zero, all, "{ctx}");
                 }
@@ -165,10 +160,13 @@ fn poses_with_contacts(a: &TriMesh, b: &TriMesh, n: usize, seed: u64) -> Vec<Aff
     let mut poses = poses_around(a, b, n, 0.2..1.3, &mut rng);
     let mut q = Proximity::<Kdop18>::default();
     let o = BuildOptions::default();
-    let (ta, tb) = (Bvh::build(a, o).unwrap(), Bvh::build(b, o).unwrap());
+    let (ta, tb) = (
+        Mesh::from_trimesh(a.clone(), o).unwrap(),
+        Mesh::from_trimesh(b.clone(), o).unwrap(),
+    );
     let mut extra = Vec::new();
     for p in poses.iter().take(n / 2) {
-        let d = q.distance((&ta, a), p, (&tb, b)).unwrap();
+        let d = q.distance(&ta, p, &tb).unwrap();
         if d.distance > 0.0 {
             let step = (d.points[1] - d.points[0]).as_vec3();
             for f in [1.0 - 1e-3, 1.0 - 1e-6, 1.02] {
@@ -256,14 +254,14 @@ fn independent_reference_on_small_pairs() {
     for (k, (a, b)) in [(&rob, &teapot), (&hand, &rob)].into_iter().enumerate() {
         let poses = poses_with_contacts(a, b, 4, 30 + k as u64);
         let (ta, tb) = (
-            Bvh::<Obb>::build(a, BuildOptions::default()).unwrap(),
-            Bvh::<Obb>::build(b, BuildOptions::default()).unwrap(),
+            Mesh::<Obb>::from_trimesh(a.clone(), BuildOptions::default()).unwrap(),
+            Mesh::<Obb>::from_trimesh(b.clone(), BuildOptions::default()).unwrap(),
         );
         let mut q = Proximity::default();
         for pose in &poses {
             let (pa, pb) = (posed(a, pose), triangles(b));
             let (want, _) = brute_nearest(&pa, &pb, triangle_triangle);
-            let got = q.distance((&ta, a), pose, (&tb, b)).unwrap();
+            let got = q.distance(&ta, pose, &tb).unwrap();
             let ext = extent(&pa).max(extent(&pb));
             assert!(
                 (got.distance - want).abs() <= 1e-5 * ext,
@@ -369,9 +367,9 @@ fn query_object_reuse_across_meshes() {
     // fresh ones (the per-query caches restart).
     let (rob, env, teapot) = (data("rob.obj"), data("env.obj"), data("teapot.obj"));
     let o = BuildOptions::default();
-    let trees: Vec<(Bvh<Kdop18>, &TriMesh)> = [&rob, &env, &teapot]
+    let trees: Vec<(Mesh<Kdop18>, &TriMesh)> = [&rob, &env, &teapot]
         .into_iter()
-        .map(|m| (Bvh::build(m, o).unwrap(), m))
+        .map(|m| (Mesh::from_trimesh(m.clone(), o).unwrap(), m))
         .collect();
     let mut rng = Pcg64::seed_from_u64(60);
     let mut shared = Proximity::<Kdop18>::default();
@@ -379,10 +377,8 @@ fn query_object_reuse_across_meshes() {
         let (i, j) = (rng.gen_range(0..3), rng.gen_range(0..3));
         let (a, b) = (&trees[i], &trees[j]);
         let pose = poses_around(a.1, b.1, 1, 0.2..1.2, &mut rng)[0];
-        let x = shared.distance((&a.0, a.1), &pose, (&b.0, b.1)).unwrap();
-        let y = Proximity::default()
-            .distance((&a.0, a.1), &pose, (&b.0, b.1))
-            .unwrap();
+        let x = shared.distance(&a.0, &pose, &b.0).unwrap();
+        let y = Proximity::default().distance(&a.0, &pose, &b.0).unwrap();
         assert_eq!(x.distance, y.distance);
         assert_eq!(x, y);
     }

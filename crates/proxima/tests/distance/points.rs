@@ -8,7 +8,7 @@ use super::shapes::{cube, flipped, weld};
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::{DVec3, Vec3};
 use proxima::narrow::{
-    closest_point_on_triangle, BoundingVolume, BuildOptions, Bvh, Kdop14, Kdop18, Kdop26, Obb,
+    closest_point_on_triangle, BoundingVolume, BuildOptions, Kdop14, Kdop18, Kdop26, Mesh, Obb,
     Proximity, TriMesh,
 };
 use rand::{Rng, SeedableRng};
@@ -46,7 +46,7 @@ fn check_closest<BV: BoundingVolume>(m: &TriMesh, points: &[Vec3]) {
             leaf_size: 3,
         },
     ] {
-        let t = Bvh::<BV>::build(m, o).unwrap();
+        let t = Mesh::<BV>::from_trimesh(m.clone(), o).unwrap();
         let mut q = Proximity::<BV>::default();
         for (k, &p) in points.iter().enumerate() {
             // Brute force with the library's point–triangle, and the reference.
@@ -62,7 +62,7 @@ fn check_closest<BV: BoundingVolume>(m: &TriMesh, points: &[Vec3]) {
                 reference = reference.min(point_triangle(p.as_dvec3(), tri.map(|v| v.as_dvec3())));
             }
             let ctx = format!("{} point {k} {p}", BV::NAME);
-            let got = q.closest_point((&t, m), p).unwrap();
+            let got = q.closest_point(&t, p).unwrap();
             assert_eq!(got.distance, want, "{ctx}");
             assert!(at.contains(&got.triangle), "{ctx}");
             assert!((got.distance - reference).abs() <= tol, "{ctx}");
@@ -77,9 +77,9 @@ fn check_closest<BV: BoundingVolume>(m: &TriMesh, points: &[Vec3]) {
                 (want * 1.5) as f32 + 1e-3,
             ] {
                 let s = Sphere::new(p, r);
-                let d = q.sphere_distance((&t, m), &s).unwrap();
+                let d = q.sphere_distance(&t, &s).unwrap();
                 assert_eq!(d.distance, (want - r as f64).max(0.0), "{ctx} r {r}");
-                let hit = q.sphere_overlaps((&t, m), &s).unwrap();
+                let hit = q.sphere_overlaps(&t, &s).unwrap();
                 assert_eq!(hit, want <= r as f64, "{ctx} r {r}");
             }
         }
@@ -118,10 +118,10 @@ fn winding(m: &TriMesh, p: Vec3) -> f64 {
 }
 
 fn check_inside<BV: BoundingVolume>(m: &TriMesh, cases: &[(Vec3, bool)]) {
-    let t = Bvh::<BV>::build(m, BuildOptions::default()).unwrap();
+    let t = Mesh::<BV>::from_trimesh(m.clone(), BuildOptions::default()).unwrap();
     let mut q = Proximity::<BV>::default();
     for (k, &(p, want)) in cases.iter().enumerate() {
-        let got = q.contains_point((&t, m), p).unwrap();
+        let got = q.contains_point(&t, p).unwrap();
         assert_eq!(got, want, "{} case {k}: {p}", BV::NAME);
     }
 }
@@ -140,14 +140,14 @@ fn inside_the_bunny_agrees_with_the_winding_number() {
     let bunny = data("bunny.obj");
     let (lo, hi) = bounds(&bunny);
     let e = hi - lo;
-    let t = Bvh::<Kdop18>::build(&bunny, BuildOptions::default()).unwrap();
+    let t = Mesh::<Kdop18>::from_trimesh(bunny.clone(), BuildOptions::default()).unwrap();
     let mut q = Proximity::<Kdop18>::default();
     let mut rng = Pcg64::seed_from_u64(71);
     let mut cases = Vec::new();
     while cases.len() < 300 {
         let p = lo + Vec3::new(rng.gen(), rng.gen(), rng.gen()) * e * 1.2 - e * 0.1;
         // Away from the surface, the float winding number is unambiguous.
-        if q.closest_point((&t, &bunny), p).unwrap().distance < 1e-3 * e.length() as f64 {
+        if q.closest_point(&t, p).unwrap().distance < 1e-3 * e.length() as f64 {
             continue;
         }
         let w = winding(&bunny, p);
@@ -215,30 +215,22 @@ fn open_meshes_give_a_deterministic_parity() {
     let teapot = data("teapot.obj");
     let mut rng = Pcg64::seed_from_u64(72);
     let pts = query_points(&teapot, 200, &mut rng);
-    let t = Bvh::<Aabb>::build(&teapot, BuildOptions::default()).unwrap();
+    let t = Mesh::<Aabb>::from_trimesh(teapot.clone(), BuildOptions::default()).unwrap();
     let mut q = Proximity::<Aabb>::default();
     let cases: Vec<(Vec3, bool)> = pts
         .iter()
-        .map(|&p| (p, q.contains_point((&t, &teapot), p).unwrap()))
+        .map(|&p| (p, q.contains_point(&t, p).unwrap()))
         .collect();
     check_inside_all(&teapot, &cases);
     // One triangle: only points on it are "inside".
     let tri = TriMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap();
-    let t = Bvh::<Obb>::build(&tri, BuildOptions::default()).unwrap();
+    let t = Mesh::<Obb>::from_trimesh(tri.clone(), BuildOptions::default()).unwrap();
     let mut q = Proximity::<Obb>::default();
-    assert!(q
-        .contains_point((&t, &tri), Vec3::new(0.25, 0.25, 0.0))
-        .unwrap());
+    assert!(q.contains_point(&t, Vec3::new(0.25, 0.25, 0.0)).unwrap());
     // Below the triangle, its ray crosses it once: parity 1.
-    assert!(q
-        .contains_point((&t, &tri), Vec3::new(0.25, 0.25, -1.0))
-        .unwrap());
-    assert!(!q
-        .contains_point((&t, &tri), Vec3::new(0.25, 0.25, 1.0))
-        .unwrap());
-    let far = q
-        .closest_point((&t, &tri), Vec3::new(0.25, 0.25, 2.0))
-        .unwrap();
+    assert!(q.contains_point(&t, Vec3::new(0.25, 0.25, -1.0)).unwrap());
+    assert!(!q.contains_point(&t, Vec3::new(0.25, 0.25, 1.0)).unwrap());
+    let far = q.closest_point(&t, Vec3::new(0.25, 0.25, 2.0)).unwrap();
     assert_eq!(far.distance, 2.0);
     assert_eq!(far.point, DVec3::new(0.25, 0.25, 0.0));
 }

@@ -62,11 +62,7 @@ impl<BV: BoundingVolume> Proximity<BV> {
     ///
     /// Cost: [`Proximity::closest_point`] of the centre. Fails on a non-finite
     /// centre or radius, a negative radius.
-    pub fn sphere_distance(
-        &mut self,
-        mesh: &Mesh<BV>,
-        s: &Sphere,
-    ) -> Result<ClosestPoint> {
+    pub fn sphere_distance(&mut self, mesh: &Mesh<BV>, s: &Sphere) -> Result<ClosestPoint> {
         s.validate()?;
         let mut c = self.closest_point(mesh, s.center)?;
         c.distance = (c.distance - s.radius as f64).max(0.0);

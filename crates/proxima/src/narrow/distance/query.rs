@@ -67,20 +67,19 @@ pub struct NearPairs {
 ///
 /// ```
 /// use proxima::glam::{Affine3A, Vec3};
-/// use proxima::narrow::{BuildOptions, Bvh, Kdop18, Proximity, TriMesh};
+/// use proxima::narrow::{Kdop18, Mesh, Proximity};
 ///
-/// let tri = TriMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]])?;
-/// let tree = Bvh::<Kdop18>::build(&tri, BuildOptions::default())?;
+/// let tri = Mesh::<Kdop18>::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]])?;
 /// let mut q = Proximity::<Kdop18>::default();
 /// // A copy of the triangle 2 above it.
 /// let pose = Affine3A::from_translation(Vec3::new(0.0, 0.0, 2.0));
-/// let d = q.distance((&tree, &tri), &pose, (&tree, &tri))?;
+/// let d = q.distance(&tri, &pose, &tri)?;
 /// assert_eq!(d.distance, 2.0);
 /// assert_eq!(d.triangles, (0, 0));
-/// assert!(q.within((&tree, &tri), &pose, (&tree, &tri), 2.0)?);
-/// assert!(!q.within((&tree, &tri), &pose, (&tree, &tri), 1.5)?);
+/// assert!(q.within(&tri, &pose, &tri, 2.0)?);
+/// assert!(!q.within(&tri, &pose, &tri, 1.5)?);
 /// // Point queries on one mesh, in its frame.
-/// let c = q.closest_point((&tree, &tri), Vec3::new(0.25, 0.25, 3.0))?;
+/// let c = q.closest_point(&tri, Vec3::new(0.25, 0.25, 3.0))?;
 /// assert_eq!((c.distance, c.triangle), (3.0, 0));
 /// # Ok::<(), proxima::Error>(())
 /// ```

@@ -7,6 +7,7 @@
 mod bounds;
 mod common;
 mod errors;
+mod mesh_methods;
 mod meshes;
 mod points;
 mod reference;

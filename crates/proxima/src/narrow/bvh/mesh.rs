@@ -1,8 +1,9 @@
 //! [`Mesh`]: a triangle mesh that owns its trees, the narrow phase's main type.
 //!
 //! Its queries are found by name: collisions in `collide.rs` ([`Mesh::collide`]),
-//! batches of rays in `par.rs`; construction, deformation and single ray casts
-//! here. Loading from a file is [`Mesh::load`], in [`io`](crate::io).
+//! distances in `narrow/distance/` ([`Mesh::distance`], [`Mesh::closest_point`],
+//! [`Mesh::contains_point`]), batches of rays in `par.rs`; construction,
+//! deformation and single ray casts here. Loading from a file is [`Mesh::load`], in [`io`](crate::io).
 
 use super::options::BuildOptions;
 use super::ray_tree::RayBvh;
@@ -32,7 +33,11 @@ use std::sync::OnceLock;
 ///   pose is the same sphere moved by that pose (what a broad phase stores).
 ///
 /// Queries: [`Mesh::collide`] / [`Mesh::collide_first`] against another mesh
-/// (with a [`Collider`](crate::narrow::Collider) for a loop of them),
+/// (with a [`Collider`](crate::narrow::Collider) for a loop of them);
+/// [`Mesh::distance`] / [`Mesh::within`] / [`Mesh::pairs_within`] against
+/// another mesh and [`Mesh::closest_point`] / [`Mesh::contains_point`] /
+/// [`Mesh::sphere_distance`] / [`Mesh::sphere_overlaps`] (with a
+/// [`Proximity`](crate::narrow::Proximity) for a loop of them);
 /// [`Mesh::cast_ray`] / [`Mesh::intersects_ray`] / [`Mesh::cast_segment`], and
 /// `Mesh::cast_rays_par` (feature `parallel`). [`Mesh::set_vertices`] deforms
 /// it, refitting both trees.

@@ -31,6 +31,16 @@ fn side(a: Point2, b: Point2, p: Point2) -> i8 {
     }
 }
 
+impl<BV: BoundingVolume> Mesh<BV> {
+    /// Whether `p` (in the mesh's frame) lies in the solid bounded by this
+    /// closed mesh (on the surface counts as inside): [`Proximity::contains_point`]
+    /// with a new query object, whose scratch space is allocated for this one
+    /// query; keep a [`Proximity`] for repeated queries.
+    pub fn contains_point(&self, p: Vec3) -> Result<bool> {
+        Proximity::default().contains_point(self, p)
+    }
+}
+
 impl<BV: BoundingVolume> Proximity<BV> {
     /// Whether `p` (in the mesh's frame) lies in the solid bounded by a closed
     /// mesh; a point on the surface counts as inside (closed, as everywhere in

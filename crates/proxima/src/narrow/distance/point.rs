@@ -26,6 +26,30 @@ pub struct ClosestPoint {
     pub counters: CostCounters,
 }
 
+impl<BV: BoundingVolume> Mesh<BV> {
+    /// The point of this mesh's surface nearest to `p` (in the mesh's frame),
+    /// its triangle and distance: [`Proximity::closest_point`] with a new query
+    /// object, whose scratch space is allocated for this one query; keep a
+    /// [`Proximity`] for repeated queries.
+    pub fn closest_point(&self, p: Vec3) -> Result<ClosestPoint> {
+        Proximity::default().closest_point(self, p)
+    }
+
+    /// The distance between the ball `s` and this mesh's surface:
+    /// [`Proximity::sphere_distance`] with a new query object (see
+    /// [`Mesh::closest_point`]).
+    pub fn sphere_distance(&self, s: &Sphere) -> Result<ClosestPoint> {
+        Proximity::default().sphere_distance(self, s)
+    }
+
+    /// Whether the ball `s` touches this mesh's surface, with an early exit:
+    /// [`Proximity::sphere_overlaps`] with a new query object (see
+    /// [`Mesh::closest_point`]).
+    pub fn sphere_overlaps(&self, s: &Sphere) -> Result<bool> {
+        Proximity::default().sphere_overlaps(self, s)
+    }
+}
+
 impl<BV: BoundingVolume> Proximity<BV> {
     /// The point of the mesh surface nearest to `p` (in the mesh's frame), the
     /// triangle it lies on and its distance, computed in `f64` (the projection on

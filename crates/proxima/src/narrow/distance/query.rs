@@ -117,6 +117,48 @@ impl<BV: BoundingVolume> Default for Proximity<BV> {
     }
 }
 
+impl<BV: BoundingVolume> Mesh<BV> {
+    /// The minimum distance between this mesh moved by `pose` and `other` (at
+    /// the identity), the nearest points and their triangles:
+    /// [`Proximity::distance`] with a new query object, whose scratch space is
+    /// allocated for this one query; keep a [`Proximity`] for repeated queries.
+    /// `0` for intersecting meshes (no penetration depth).
+    ///
+    /// ```
+    /// use proxima::glam::{Affine3A, Vec3};
+    /// use proxima::narrow::Mesh;
+    ///
+    /// let tri: Mesh = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]])?;
+    /// let up = Affine3A::from_translation(Vec3::new(0.0, 0.0, 2.0));
+    /// assert_eq!(tri.distance(&up, &tri)?.distance, 2.0);
+    /// assert!(tri.within(&up, &tri, 2.0)? && !tri.within(&up, &tri, 1.5)?);
+    /// assert_eq!(tri.closest_point(Vec3::new(0.25, 0.25, 3.0))?.distance, 3.0);
+    /// # Ok::<(), proxima::Error>(())
+    /// ```
+    pub fn distance(&self, pose: &Affine3A, other: &Mesh<BV>) -> Result<MeshDistance> {
+        Proximity::default().distance(self, pose, other)
+    }
+
+    /// Whether this mesh moved by `pose` and `other` are within `margin` of each
+    /// other (closed), with an early exit: [`Proximity::within`] with a new query
+    /// object (see [`Mesh::distance`]).
+    pub fn within(&self, pose: &Affine3A, other: &Mesh<BV>, margin: f64) -> Result<bool> {
+        Proximity::default().within(self, pose, other, margin)
+    }
+
+    /// Every triangle pair of this mesh moved by `pose` and `other` within
+    /// `margin`: [`Proximity::pairs_within`] with a new query object (see
+    /// [`Mesh::distance`]).
+    pub fn pairs_within(
+        &self,
+        pose: &Affine3A,
+        other: &Mesh<BV>,
+        margin: f64,
+    ) -> Result<NearPairs> {
+        Proximity::default().pairs_within(self, pose, other, margin)
+    }
+}
+
 /// The minimum distance between `a` moved by `pose` and `b`. See
 /// [`Proximity::distance`].
 pub fn mesh_distance<BV: BoundingVolume>(

@@ -45,7 +45,8 @@ impl<BV: BoundingVolume> VolumeSource<BV> for Precomputed<'_, BV> {
 }
 
 /// Volumes transformed on first use ([`BoundingVolume::transformed`]) and enlarged
-/// by the slack, counting each as one node update.
+/// by the slack, counting each as one node update. A [`VolumeSource`] as every
+/// source of volumes posed in the fixed frame (`moving.rs`).
 pub(crate) struct Lazy<'a, BV> {
     pub nodes: &'a [Node<BV>],
     pub pose: glam::Affine3A,
@@ -63,17 +64,6 @@ impl<BV: BoundingVolume> Lazy<'_, BV> {
         let (nodes, pose, slack) = (self.nodes, &self.pose, self.slack);
         self.cache
             .get(i, || nodes[i].bv.transformed(pose).inflated(slack))
-    }
-}
-
-impl<BV: BoundingVolume> VolumeSource<BV> for Lazy<'_, BV> {
-    #[inline]
-    fn overlaps(&mut self, i: usize, other: &BV) -> bool {
-        self.get(i).overlaps_fixed(other)
-    }
-    #[inline]
-    fn size(&mut self, i: usize) -> f32 {
-        self.get(i).size()
     }
 }
 

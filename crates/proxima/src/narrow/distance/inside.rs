@@ -1,10 +1,11 @@
 //! Whether a point is inside a closed mesh: the parity of the triangles crossed
 //! by the vertical ray above it, every sign decided exactly.
 
+use super::point::point_slack;
 use super::query::Proximity;
 use crate::error::check_vec3;
 use crate::geom::Ray;
-use crate::narrow::bv::{slack_for, BoundingVolume};
+use crate::narrow::bv::BoundingVolume;
 use crate::narrow::predicates::{orient2d, orient3d, project, Point2};
 use crate::narrow::{segment_triangle_intersect, CostCounters, Mesh};
 use crate::Result;
@@ -68,7 +69,7 @@ impl<BV: BoundingVolume> Proximity<BV> {
         check_vec3(p, "query point")?;
         let (t, m) = (mesh.bvh(), mesh.trimesh());
         let ray = Ray::new(p, Vec3::Z);
-        let slack = slack_for(2.0 * (t.coord_bound + p.abs().element_sum()), 0.0);
+        let slack = point_slack(t, p);
         let (verts, p2) = (m.vertices(), project(p, 2));
         let mut c = CostCounters::default();
         let mut odd = false;

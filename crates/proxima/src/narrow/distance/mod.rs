@@ -5,9 +5,10 @@
 //!
 //! - `triangle.rs`, `segment.rs`: closest points of triangles, segments and
 //!   points in `f64` ([`triangle_distance`], [`closest_point_on_triangle`]);
-//! - `bounds.rs`: the volumes' distance lower bounds under a pose, from the same
-//!   three sources as collision (pose in the test, refit, lazy transform);
-//! - `traverse.rs`: best-first and depth-first descents with a cut;
+//! - `traverse.rs`: best-first and depth-first descents with a cut, over the
+//!   moving tree's volumes from the same sources as collision (the pose in the
+//!   test, a refit, a lazy transform, exact near the leaves: `narrow/bvh/moving.rs`,
+//!   shared with [`Collider`](crate::narrow::Collider), with its rounding slack);
 //! - `query.rs`: [`Proximity`], the reusable query object, and the mesh–mesh
 //!   queries; `point.rs`: point and ball queries; `inside.rs`: the inside test.
 //!
@@ -29,7 +30,6 @@
 //! volumes' bounds are computed in `f32` and lowered by the rounding slack of
 //! collision, so they never cut a pair they should keep.
 
-mod bounds;
 mod inside;
 mod point;
 mod query;

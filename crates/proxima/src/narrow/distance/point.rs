@@ -7,9 +7,15 @@ use super::triangle::Tri64;
 use crate::error::check_vec3;
 use crate::geom::Sphere;
 use crate::narrow::bv::{slack_for, BoundingVolume};
-use crate::narrow::{CostCounters, Mesh};
+use crate::narrow::{Bvh, CostCounters, Mesh};
 use crate::Result;
 use glam::{DVec3, Vec3};
+
+/// The rounding slack of a query of tree `t` against the point `p` (no pose):
+/// [`slack_for`] the largest `|x| + |y| + |z|` of a difference of their points.
+pub(super) fn point_slack<BV>(t: &Bvh<BV>, p: Vec3) -> f32 {
+    slack_for(2.0 * (t.coord_bound + p.abs().element_sum()), 0.0)
+}
 
 /// The point of a mesh nearest to a query point (or ball).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -121,7 +127,7 @@ impl<BV: BoundingVolume> Proximity<BV> {
         any: bool,
     ) -> Result<(Option<(f64, DVec3, u32)>, CostCounters)> {
         let (t, m) = (mesh.bvh(), mesh.trimesh());
-        let slack = slack_for(2.0 * (t.coord_bound + p.abs().element_sum()), 0.0);
+        let slack = point_slack(t, p);
         let probe = BV::from_points(&[p]).inflated(slack);
         let (p64, verts) = (p.as_dvec3(), m.vertices());
         let mut c = CostCounters::default();

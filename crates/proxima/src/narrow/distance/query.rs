@@ -2,17 +2,16 @@
 //! points, "within a margin" with early exit, and every triangle pair closer than
 //! a margin.
 
-use super::bounds::ExactLeaves;
 use super::traverse::{descend, Cut, Frontier, Order, Visit};
 use super::triangle::{contact_witness, disjoint_closest, plane_gap, Tri64};
-use crate::narrow::bv::{slack_for, BoundingVolume};
+use crate::narrow::bv::BoundingVolume;
+use crate::narrow::bvh::moving::{query_slack, AutoUpdate, Descent, LowerBounds, MovingVolumes};
 use crate::narrow::bvh::pose_deviation;
-use crate::narrow::bvh::traverse::{Lazy, Local, Precomputed};
 use crate::narrow::bvh::tri_cache::QueryCache;
 use crate::narrow::triangles_intersect;
 use crate::narrow::{Bvh, CostCounters, Mesh, RotationUpdate, TriMesh};
 use crate::{Error, Result};
-use glam::{Affine3A, DVec3, Mat3A, Vec3};
+use glam::{Affine3A, DVec3, Vec3};
 
 /// The minimum distance between two posed meshes, with a nearest pair of points.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,9 +95,7 @@ pub struct Proximity<BV> {
     /// reached node, and 1.8 M with [`RotationUpdate::Refit`], which refits all
     /// of them).
     pub rotation: RotationUpdate,
-    world_vertices: Vec<Vec3>,
-    world: Vec<BV>,
-    pub(super) cache: QueryCache<BV>,
+    moving: MovingVolumes<BV>,
     pub(super) frontier: Frontier,
     /// Prepared triangles of the moving mesh (posed) and of the fixed one.
     tris_a: QueryCache<Tri64>,
@@ -229,9 +226,7 @@ impl<BV: BoundingVolume> Proximity<BV> {
     pub fn new(rotation: RotationUpdate) -> Self {
         Proximity {
             rotation,
-            world_vertices: Vec::new(),
-            world: Vec::new(),
-            cache: QueryCache::default(),
+            moving: MovingVolumes::default(),
             frontier: Frontier::default(),
             tris_a: QueryCache::default(),
             tris_b: QueryCache::default(),
@@ -361,17 +356,13 @@ impl<BV: BoundingVolume> Proximity<BV> {
         let (ta, ma) = (a.bvh(), a.trimesh());
         let (tb, mb) = (b.bvh(), b.trimesh());
         check_moved_range(ma, ta, pose, dev)?;
-        // The collision queries' rounding slack (same bound on coordinates).
-        let t1 = Vec3::from(pose.translation).abs().element_sum();
-        let scale = 2.0 * (1.8 * ta.coord_bound * (1.0 + dev) + t1 + tb.coord_bound);
-        let slack = slack_for(scale, dev);
-        let (va, vb) = (ma.vertices(), mb.vertices());
+        // The collision queries' rounding slack: the volumes keep what they keep.
+        let slack = query_slack(ta, pose, dev, tb);
+        let vb = mb.vertices();
         let mut c = CostCounters::default();
         let Proximity {
             rotation,
-            world_vertices,
-            world,
-            cache,
+            moving,
             frontier,
             tris_a,
             tris_b,
@@ -417,7 +408,7 @@ impl<BV: BoundingVolume> Proximity<BV> {
         // of a pair that may overlap but does not is deferred until every such
         // pair has been tested (`Visit::Settle`): if any intersects, the answer
         // is 0 and those distances were never needed.
-        let mut visit = |corner: &dyn Fn(u32) -> Vec3, v: Visit, cut: &mut Cut| {
+        let visit = |corner: &dyn Fn(u32) -> Vec3, v: Visit, cut: &mut Cut| -> bool {
             let (la, lb, bound) = match v {
                 Visit::Leaf(la, lb, bound) => (la, lb, bound),
                 Visit::Settle => {
@@ -465,67 +456,51 @@ impl<BV: BoundingVolume> Proximity<BV> {
             }
             false
         };
-        let moved = |v: u32| pose.transform_point3(va[v as usize]);
-        let rotated = pose.matrix3 != Mat3A::IDENTITY;
-        // One descent per volume source (a macro: each source is its own type).
-        macro_rules! go {
-            ($src:expr, $corner:expr) => {
-                descend(
-                    ta,
-                    $src,
-                    tb,
-                    order,
-                    frontier,
-                    &mut c.nv,
-                    &mut cut,
-                    |v, cut| visit($corner, v, cut),
-                )
-            };
-        }
-        match (BV::AXIS_ALIGNED && rotated, *rotation) {
-            (false, _) => {
-                let motion = BV::motion(pose, slack);
-                go!(
-                    &mut Local {
-                        nodes: &ta.nodes,
-                        motion
-                    },
-                    &moved
-                );
-            }
-            (true, RotationUpdate::Refit) => {
-                world_vertices.clear();
-                world_vertices.extend(va.iter().map(|&v| pose.transform_point3(v)));
-                c.nu = ta.world_volumes(world_vertices, slack, world);
-                let wv: &[Vec3] = world_vertices;
-                go!(&mut Precomputed(world), &|v: u32| wv[v as usize]);
-            }
-            (true, update) => {
-                cache.begin(ta.nodes.len(), ta.nodes[0].bv);
-                let lazy = Lazy {
-                    nodes: &ta.nodes,
-                    pose: *pose,
-                    slack,
-                    cache,
-                    updates: 0,
-                };
-                c.nu = if update == RotationUpdate::Conservative {
-                    let mut src = lazy;
-                    go!(&mut src, &moved);
-                    src.updates
-                } else {
-                    let mut src = ExactLeaves {
-                        lazy,
-                        tris: &ta.tris,
-                        vertices: va,
-                    };
-                    go!(&mut src, &moved);
-                    src.lazy.updates
-                };
-            }
-        }
+        let mut d = Search {
+            a: ta,
+            b: tb,
+            order,
+            frontier,
+            nv: &mut c.nv,
+            cut: &mut cut,
+            visit,
+        };
+        c.nu = moving.descend(a, pose, slack, *rotation, AutoUpdate::ExactLeaves, &mut d);
         c.np = np;
         self.counters = c;
         Ok(c)
+    }
+}
+
+/// The distance descent ([`descend`]) with its leaf visitor, for any source of
+/// the moving volumes.
+struct Search<'q, BV, V> {
+    a: &'q Bvh<BV>,
+    b: &'q Bvh<BV>,
+    order: Order,
+    frontier: &'q mut Frontier,
+    nv: &'q mut u64,
+    cut: &'q mut Cut,
+    visit: V,
+}
+
+impl<BV, V> Descent<BV> for Search<'_, BV, V>
+where
+    BV: BoundingVolume,
+    V: FnMut(&dyn Fn(u32) -> Vec3, Visit, &mut Cut) -> bool,
+{
+    #[inline]
+    fn descend<S: LowerBounds<BV>>(&mut self, src: &mut S, corner: &dyn Fn(u32) -> Vec3) {
+        let visit = &mut self.visit;
+        descend(
+            self.a,
+            src,
+            self.b,
+            self.order,
+            self.frontier,
+            self.nv,
+            self.cut,
+            |v, cut| visit(corner, v, cut),
+        );
     }
 }

@@ -2,8 +2,8 @@
 //! against a point, visiting node pairs whose lower bound passes a [`Cut`] that
 //! the leaves may lower as they find nearer triangles.
 
-use super::bounds::LowerBounds;
 use crate::narrow::bv::{positive, BoundingVolume};
+use crate::narrow::bvh::moving::LowerBounds;
 use crate::narrow::bvh::Node;
 use crate::narrow::Bvh;
 use std::cmp::Reverse;

@@ -249,14 +249,14 @@ impl<BV: BoundingVolume> Collider<BV> {
             }
             false
         };
-        let mut d = Traversal {
+        let d = Traversal {
             a: ta,
             b: tb,
             stack,
             nv: &mut c.nv,
             leaf,
         };
-        c.nu = moving.descend(a, pose, slack, *rotation, AutoUpdate::Conservative, &mut d);
+        c.nu = moving.descend(a, pose, slack, *rotation, d);
         c.np = np;
         Ok(c)
     }
@@ -277,11 +277,21 @@ where
     BV: BoundingVolume,
     L: FnMut(&dyn Fn(u32) -> Vec3, usize, usize) -> bool,
 {
+    const AUTO: AutoUpdate = AutoUpdate::Conservative;
+
     #[inline]
-    fn descend<S: LowerBounds<BV>>(&mut self, src: &mut S, corner: &dyn Fn(u32) -> Vec3) {
-        let leaf = &mut self.leaf;
-        traverse(self.a, src, self.b, self.stack, self.nv, |x, y| {
-            leaf(corner, x, y)
-        });
+    fn descend<S, C>(self, src: &mut S, corner: &C)
+    where
+        S: LowerBounds<BV>,
+        C: Fn(u32) -> Vec3,
+    {
+        let Traversal {
+            a,
+            b,
+            stack,
+            nv,
+            mut leaf,
+        } = self;
+        traverse(a, src, b, stack, nv, |x, y| leaf(corner, x, y));
     }
 }

@@ -456,7 +456,7 @@ impl<BV: BoundingVolume> Proximity<BV> {
             }
             false
         };
-        let mut d = Search {
+        let d = Search {
             a: ta,
             b: tb,
             order,
@@ -465,7 +465,7 @@ impl<BV: BoundingVolume> Proximity<BV> {
             cut: &mut cut,
             visit,
         };
-        c.nu = moving.descend(a, pose, slack, *rotation, AutoUpdate::ExactLeaves, &mut d);
+        c.nu = moving.descend(a, pose, slack, *rotation, d);
         c.np = np;
         self.counters = c;
         Ok(c)
@@ -489,18 +489,25 @@ where
     BV: BoundingVolume,
     V: FnMut(&dyn Fn(u32) -> Vec3, Visit, &mut Cut) -> bool,
 {
+    const AUTO: AutoUpdate = AutoUpdate::ExactLeaves;
+
     #[inline]
-    fn descend<S: LowerBounds<BV>>(&mut self, src: &mut S, corner: &dyn Fn(u32) -> Vec3) {
-        let visit = &mut self.visit;
-        descend(
-            self.a,
-            src,
-            self.b,
-            self.order,
-            self.frontier,
-            self.nv,
-            self.cut,
-            |v, cut| visit(corner, v, cut),
-        );
+    fn descend<S, C>(self, src: &mut S, corner: &C)
+    where
+        S: LowerBounds<BV>,
+        C: Fn(u32) -> Vec3,
+    {
+        let Search {
+            a,
+            b,
+            order,
+            frontier,
+            nv,
+            cut,
+            mut visit,
+        } = self;
+        descend(a, src, b, order, frontier, nv, cut, |v, cut| {
+            visit(corner, v, cut)
+        });
     }
 }

@@ -280,18 +280,9 @@ where
     const AUTO: AutoUpdate = AutoUpdate::Conservative;
 
     #[inline]
-    fn descend<S, C>(self, src: &mut S, corner: &C)
-    where
-        S: LowerBounds<BV>,
-        C: Fn(u32) -> Vec3,
-    {
-        let Traversal {
-            a,
-            b,
-            stack,
-            nv,
-            mut leaf,
-        } = self;
-        traverse(a, src, b, stack, nv, |x, y| leaf(corner, x, y));
+    fn descend(mut self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3) {
+        traverse(self.a, src, self.b, self.stack, self.nv, |x, y| {
+            (self.leaf)(corner, x, y)
+        });
     }
 }

@@ -184,10 +184,7 @@ pub(crate) trait Descent<BV: BoundingVolume> {
     /// `f32` values whichever the source). The corner is a type parameter, not
     /// a `dyn`, so that the leaf tests inline it (W5 collision: 5% more
     /// instructions through a `&dyn Fn`).
-    fn descend<S, C>(self, src: &mut S, corner: &C)
-    where
-        S: LowerBounds<BV>,
-        C: Fn(u32) -> Vec3;
+    fn descend(self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3);
 }
 
 /// The scratch space of the moving volumes (kept by the query objects: no

@@ -492,22 +492,16 @@ where
     const AUTO: AutoUpdate = AutoUpdate::ExactLeaves;
 
     #[inline]
-    fn descend<S, C>(self, src: &mut S, corner: &C)
-    where
-        S: LowerBounds<BV>,
-        C: Fn(u32) -> Vec3,
-    {
-        let Search {
-            a,
-            b,
-            order,
-            frontier,
-            nv,
-            cut,
-            mut visit,
-        } = self;
-        descend(a, src, b, order, frontier, nv, cut, |v, cut| {
-            visit(corner, v, cut)
-        });
+    fn descend(mut self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3) {
+        descend(
+            self.a,
+            src,
+            self.b,
+            self.order,
+            self.frontier,
+            self.nv,
+            self.cut,
+            |v, cut| (self.visit)(corner, v, cut),
+        );
     }
 }

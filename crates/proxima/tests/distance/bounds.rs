@@ -128,3 +128,70 @@ fn touching_volumes_bound_zero() {
     zero::<Obb>(&a, &b);
     zero::<Sphere>(&a, &b);
 }
+
+#[test]
+fn lower_bounds_hold_at_huge_scales() {
+    // Regression: beyond √f32::MAX ≈ 1.8e19 the f32 squares of the bounds
+    // overflowed, giving infinite "lower bounds" (cutting every pair of a
+    // distance query); and a sphere's fit an infinite radius. Clouds scaled
+    // up to 1e37: every bound is finite, at most the true (f64) distance, and
+    // still useful.
+    fn min_distance64(a: &[Vec3], b: &[Vec3]) -> f64 {
+        a.iter()
+            .flat_map(|p| b.iter().map(move |q| p.as_dvec3().distance(q.as_dvec3())))
+            .fold(f64::INFINITY, f64::min)
+    }
+    fn check<BV: BoundingVolume>(scale: f32) {
+        let mut rng = Pcg64::seed_from_u64(12);
+        let (mut ratio, mut separated) = (0.0f64, 0);
+        for case in 0..400 {
+            let a: Vec<Vec3> = cloud(&mut rng, 12).iter().map(|&p| p * scale).collect();
+            let b: Vec<Vec3> = cloud(&mut rng, 12).iter().map(|&p| p * scale).collect();
+            let mut pose = Affine3A::from_rotation_translation(
+                random_rotation(&mut rng),
+                Vec3::splat(1.5 * scale),
+            );
+            if case % 3 == 0 {
+                pose.matrix3 = proxima::glam::Mat3A::IDENTITY;
+            }
+            let moved: Vec<Vec3> = a.iter().map(|&p| pose.transform_point3(p)).collect();
+            let truth = min_distance64(&moved, &b);
+            let (va, vb) = (BV::from_points(&a), BV::from_points(&b));
+            let bounds = [
+                va.distance_lower_bound(&BV::motion(&pose, 0.0), &vb),
+                va.transformed(&pose).distance_lower_bound_fixed(&vb),
+                BV::from_points(&moved).distance_lower_bound_fixed(&vb),
+            ];
+            let exact_pose = !BV::AXIS_ALIGNED || case % 3 == 0;
+            // f32 rounding of the fits and transforms, relative to the scale.
+            let tol = 1e-4 * scale as f64;
+            for (k, lb) in bounds.into_iter().enumerate() {
+                if k == 0 && !exact_pose {
+                    continue;
+                }
+                let ctx = format!("{} scale {scale} case {case} bound {k}", BV::NAME);
+                assert!(lb >= 0.0 && lb.is_finite(), "{ctx}: {lb}");
+                assert!(lb as f64 <= truth + tol, "{ctx}: {lb} > {truth}");
+            }
+            if truth > 2.0 * scale as f64 {
+                separated += 1;
+                ratio += bounds[2] as f64 / truth;
+            }
+        }
+        assert!(separated > 20, "{separated}");
+        let mean = ratio / separated as f64;
+        assert!(
+            mean > 0.4,
+            "{} scale {scale}: mean bound / distance {mean}",
+            BV::NAME
+        );
+    }
+    for scale in [1e20f32, 1e30, 1e37] {
+        check::<Aabb>(scale);
+        check::<Kdop14>(scale);
+        check::<Kdop18>(scale);
+        check::<Kdop26>(scale);
+        check::<Obb>(scale);
+        check::<Sphere>(scale);
+    }
+}

@@ -149,7 +149,8 @@ pub fn extent(ts: &[[Vec3; 3]]) -> f64 {
             hi = hi.max(*v);
         }
     }
-    (hi - lo).length() as f64
+    // In f64: beyond √f32::MAX the f32 length overflows.
+    (hi.as_dvec3() - lo.as_dvec3()).length()
 }
 
 /// A sub-mesh: the triangles whose centroid is within `r` of `c` (vertices

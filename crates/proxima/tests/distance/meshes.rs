@@ -362,6 +362,32 @@ fn cubes_with_parallel_faces_and_shared_corners() {
 }
 
 #[test]
+fn huge_coordinates() {
+    // Regression: beyond √f32::MAX ≈ 1.8e19 squared distances overflow f32; a
+    // sphere volume's fit and distance bound did (an infinite radius, an
+    // infinite "lower bound"). Every volume finds brute force's answers.
+    let quarter = Mat3::from_cols(Vec3::Y, -Vec3::X, Vec3::Z);
+    for s in [2e19f32, 1e30, 1e37] {
+        let (a, b) = (cube(2, s), cube(3, s));
+        let poses = [
+            Affine3A::from_translation(Vec3::new(1.5 * s, 0.25 * s, 0.0)), // s/2 apart
+            Affine3A::from_translation(Vec3::new(s, 0.0, 0.0)),            // shared face
+            Affine3A::from_translation(Vec3::splat(0.5 * s)),              // intersecting
+            Affine3A::from_mat3_translation(quarter, Vec3::new(2.5 * s, s, 3.0 * s)),
+            Affine3A::from_rotation_translation(
+                proxima::glam::Quat::from_rotation_arc(Vec3::X, Vec3::ONE.normalize()),
+                Vec3::new(-1.5 * s, 0.5 * s, 0.25 * s),
+            ),
+        ];
+        let w = wants(&a, &b, &poses, poses.len());
+        let apart: Vec<f64> = w.iter().map(|w| w.distance / s as f64).collect();
+        assert!((apart[0] - 0.5).abs() < 1e-6 && apart[1] == 0.0 && apart[2] == 0.0);
+        assert!(apart[3] > 0.5 && apart[4] > 0.1, "{apart:?}");
+        check_all(&a, &b, &w);
+    }
+}
+
+#[test]
 fn query_object_reuse_across_meshes() {
     // One query object over different mesh pairs and sizes gives the answers of
     // fresh ones (the per-query caches restart).

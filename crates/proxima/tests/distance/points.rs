@@ -36,6 +36,16 @@ fn query_points(m: &TriMesh, n: usize, rng: &mut Pcg64) -> Vec<Vec3> {
         .collect()
 }
 
+/// [`check_closest`] with every volume kind.
+fn check_closest_all(m: &TriMesh, points: &[Vec3]) {
+    check_closest::<Aabb>(m, points);
+    check_closest::<Kdop14>(m, points);
+    check_closest::<Kdop18>(m, points);
+    check_closest::<Kdop26>(m, points);
+    check_closest::<Obb>(m, points);
+    check_closest::<Sphere>(m, points);
+}
+
 fn check_closest<BV: BoundingVolume>(m: &TriMesh, points: &[Vec3]) {
     let tris = triangles(m);
     let tol = 1e-9 * extent(&tris);
@@ -92,12 +102,7 @@ fn closest_points_match_brute_force() {
     for name in ["bunny.obj", "teapot.obj", "rob.obj", "forearm.stl"] {
         let m = data(name);
         let pts = query_points(&m, 60, &mut rng);
-        check_closest::<Aabb>(&m, &pts);
-        check_closest::<Kdop14>(&m, &pts);
-        check_closest::<Kdop18>(&m, &pts);
-        check_closest::<Kdop26>(&m, &pts);
-        check_closest::<Obb>(&m, &pts);
-        check_closest::<Sphere>(&m, &pts);
+        check_closest_all(&m, &pts);
     }
 }
 
@@ -233,4 +238,27 @@ fn open_meshes_give_a_deterministic_parity() {
     let far = q.closest_point(&t, Vec3::new(0.25, 0.25, 2.0)).unwrap();
     assert_eq!(far.distance, 2.0);
     assert_eq!(far.point, DVec3::new(0.25, 0.25, 0.0));
+}
+
+#[test]
+fn huge_coordinates() {
+    // Regression: beyond √f32::MAX ≈ 1.8e19 a sphere volume's fitted radius
+    // overflowed to infinity and its ray test missed (the inside test then
+    // answered "outside" for inside points). Every volume answers as brute
+    // force and the closed form, up to f32::MAX / 2 (`cube` forms `2 s`).
+    for s in [2e19f32, 1e30, f32::MAX / 2.0] {
+        let m = cube(2, s);
+        let cases = [
+            (Vec3::splat(0.5 * s), true),
+            (Vec3::new(0.25 * s, 0.75 * s, 0.5 * s), true),
+            (Vec3::new(0.5 * s, 0.5 * s, s), true), // on the top face
+            (Vec3::splat(s), true),                 // a corner
+            (Vec3::new(0.5 * s, 0.5 * s, -0.5 * s), false),
+            (Vec3::new(-0.25 * s, 0.5 * s, 0.5 * s), false),
+            (Vec3::new(1.0, 2.0, -3.0), false),
+        ];
+        check_inside_all(&m, &cases);
+        let pts: Vec<Vec3> = cases.iter().map(|c| c.0).collect();
+        check_closest_all(&m, &pts);
+    }
 }

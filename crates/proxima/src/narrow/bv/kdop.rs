@@ -1,6 +1,6 @@
 //! k-DOPs (discrete orientation polytopes) with K = 14, 18, 26 [sources: kdop].
 
-use super::{clip_slab, BoundingVolume};
+use super::{clip_slab, wide_gap, BoundingVolume};
 use crate::geom::Ray;
 use crate::{Error, Result};
 use glam::{Affine3A, Vec3};
@@ -201,27 +201,39 @@ impl<const K: usize> Kdop<K> {
     /// boxes' distance), or the largest gap of another slab divided by its axis'
     /// length, whichever is larger. Each is a lower bound on the distance of the
     /// contents. Written as plain loops over the slabs (no NaN-aware `max`, no
-    /// zero shift added) because it runs once per volume pair.
+    /// zero shift added) because it runs once per volume pair; a result that
+    /// overflowed or is NaN is computed again in `f64` ([`wide_gap`]).
     #[inline(always)]
     fn gap(&self, m: Option<&[f32; K]>, o: &Self) -> f32 {
         let h = Self::H;
-        let g = |i: usize| {
+        // Slab `i` of `self` (moved) and of `o`.
+        let slab = |i: usize| {
             let (lo, hi) = match m {
                 Some(m) => (self.d[i] + m[i], self.d[i + h] + m[i + h]),
                 None => (self.d[i], self.d[i + h]),
             };
-            fmax(o.d[i] - hi, lo - o.d[i + h])
+            (lo, hi, o.d[i], o.d[i + h])
+        };
+        let g = |i: usize| {
+            let (lo, hi, lo_o, hi_o) = slab(i);
+            fmax(lo_o - hi, lo - hi_o)
         };
         let mut sq = 0.0f32;
         for i in 0..3 {
             let x = fmax(g(i), 0.0);
             sq += x * x;
         }
-        let mut slab = 0.0f32;
+        let mut slabs = 0.0f32;
         for i in 3..h {
-            slab = fmax(slab, g(i) * Self::inv_norm(i));
+            slabs = fmax(slabs, g(i) * Self::inv_norm(i));
         }
-        fmax(sq.sqrt(), slab)
+        let r = fmax(sq.sqrt(), slabs);
+        if r <= f32::MAX {
+            r
+        } else {
+            // Overflowed (gaps beyond √f32::MAX) or NaN (infinite interval ends).
+            wide_gap(slab, h, |i| if i < 3 { 1.0 } else { Self::inv_norm(i) })
+        }
     }
 }
 

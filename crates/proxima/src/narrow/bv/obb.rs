@@ -25,6 +25,8 @@ pub struct Obb {
 
 impl Obb {
     /// The box with the given axes that bounds `points` (non-empty). O(points).
+    /// Finite for every finite point set bounded along the axes within the `f32`
+    /// range (an extent wider than `f32::MAX` is halved before it is formed).
     pub fn with_axes(axes: Mat3, points: impl Iterator<Item = Vec3>) -> Obb {
         let at = axes.transpose();
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -34,10 +36,16 @@ impl Obb {
             lo = lo.min(q);
             hi = hi.max(q);
         }
+        let (mut mid, mut half) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+        if !(mid.is_finite() && half.is_finite()) {
+            // The sum or difference overflowed (extents near `f32::MAX`): halving
+            // first is exact at these magnitudes (it only rounds subnormals).
+            (mid, half) = (lo * 0.5 + hi * 0.5, hi * 0.5 - lo * 0.5);
+        }
         Obb {
-            center: axes * ((lo + hi) * 0.5),
+            center: axes * mid,
             axes,
-            half: (hi - lo) * 0.5,
+            half,
         }
     }
 
@@ -300,9 +308,19 @@ impl BoundingVolume for Obb {
             let gap = lhs - rhs - Vec3A::splat(slack);
             let ok = gap.cmpgt(Vec3A::ZERO) & len2.cmpge(Vec3A::splat(0.0025));
             if ok.any() {
-                // gap / |L| through its square: one square root for the three.
+                // gap / |L| through its square: one square root for the three;
+                // three where the square overflows (gaps beyond √f32::MAX).
                 let q2 = Vec3A::select(ok, gap * gap / len2, Vec3A::ZERO).max_element();
-                best = best.max(q2.sqrt() * (1.0 / 1.001));
+                let q = if q2 <= f32::MAX {
+                    q2.sqrt()
+                } else {
+                    (0..3)
+                        .filter(|&i| ok.bitmask() & (1 << i) != 0)
+                        .map(|i| gap[i] / len2[i].sqrt())
+                        .fold(0.0f32, f32::max)
+                        .min(f32::MAX)
+                };
+                best = best.max(q * (1.0 / 1.001));
             }
         }
         positive(best)

@@ -1,7 +1,8 @@
 #!/bin/bash
 # Regenerates docs/bench/* (the raw outputs behind BENCHMARKS.md) from the
 # release bench binary. Run from the repo root after
-# `cargo build --release -p proxima-bench`; takes about 6 minutes on 2 cores.
+# `cargo build --release -p proxima-bench` (and `scripts/peers.sh` for the C++
+# peers of W5); takes about 8 minutes on 2 cores.
 set -e
 B=./target/release/proxima-bench
 D=docs/bench
@@ -17,8 +18,12 @@ $B w4 --json > $D/w4.json 2>/dev/null
 $B w4 --threads 2 --clock wall --only UniformGrid3d,LinearOctree,LooseKdTree,rstar,parry3d > $D/w4-wall-t2.txt 2>/dev/null
 $B w4 --threads 1 --clock wall --only UniformGrid3d,LinearOctree,LooseKdTree,rstar,parry3d > $D/w4-wall-t1.txt 2>/dev/null
 uptime >> $D/load.txt
-$B w5 > $D/w5.txt 2>/dev/null
-$B w5 --json > $D/w5.json 2>/dev/null
+# W5 with the C++ peers (FCL, coal) when scripts/peers.sh has built them (the
+# table says so otherwise); wall clock, as their harness measures.
+$B w5 --clock wall > $D/w5.txt 2>/dev/null
+$B w5 --clock wall --json > $D/w5.json 2>/dev/null
+# W6 runs Embree beside ours when scripts/peers.sh has built target/peers/w6_rays.
+[ -x target/peers/w6_rays ] || echo "bench_all: no target/peers/w6_rays (scripts/peers.sh): W6 without Embree" >&2
 $B w6 > $D/w6.txt 2>/dev/null
 $B w6 --json > $D/w6.json 2>/dev/null
 uptime >> $D/load.txt

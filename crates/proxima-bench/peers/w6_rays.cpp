@@ -3,7 +3,7 @@
 //
 //   w6_rays --lib embree MESH RAYS [--threads K] [--reps N]
 //           [--modes single,packet,stream] [--quality high|medium|low]
-//           [--build-threads N] [--config EMBREE_CONFIG] [--brute N]
+//           [--build-threads N] [--config EMBREE_CONFIG] [--brute N] [--clock wall|cpu]
 //
 // Prints one line per ray, `hit TRI T` (T with 9 significant digits) or `hit -`,
 // from rtcIntersect1; then `#` lines: the build time, and for every mode the
@@ -16,6 +16,8 @@
 
 #include <pmmintrin.h>
 #include <xmmintrin.h>
+
+#include <time.h>
 
 #include <atomic>
 #include <limits>
@@ -173,9 +175,25 @@ void flush_denormals() {
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
 }
 
-// Wall ns for one pass over all rays on `threads` threads (chunks of 1024 rays
-// handed out by an atomic counter; threads are started per pass, ~0.1 ms).
-double pass(Kernel k, RTCScene scene, const std::vector<Ray>& rays, std::vector<Hit>& out, unsigned threads) {
+// CPU time of the calling thread (ns): with `--clock cpu`, one-thread passes
+// leave out the time the thread spent descheduled, as the Rust bench's default
+// clock does, so the two stay comparable on a loaded machine.
+uint64_t thread_cpu_ns() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<uint64_t>(ts.tv_sec) * 1000000000u + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+// Ns for one pass over all rays on `threads` threads (chunks of 1024 rays
+// handed out by an atomic counter; threads are started per pass, ~0.1 ms): wall
+// time, or the thread's CPU time for a one-thread pass when `cpu`.
+double pass(Kernel k, RTCScene scene, const std::vector<Ray>& rays, std::vector<Hit>& out, unsigned threads,
+            bool cpu = false) {
+    if (threads <= 1 && cpu) {
+        uint64_t t0 = thread_cpu_ns();
+        k(scene, rays.data(), out.data(), rays.size());
+        return static_cast<double>(thread_cpu_ns() - t0);
+    }
     uint64_t t0 = peers::now_ns();
     if (threads <= 1) {
         k(scene, rays.data(), out.data(), rays.size());
@@ -236,7 +254,7 @@ Hit brute(const peers::Mesh& m, const Ray& r) {
 
 const char* USAGE =
     "usage: w6_rays --lib embree MESH RAYS [--threads K] [--reps N] [--modes single,packet,stream] "
-    "[--quality high|medium|low] [--build-threads N] [--config EMBREE_CONFIG] [--brute N]";
+    "[--quality high|medium|low] [--build-threads N] [--config EMBREE_CONFIG] [--brute N] [--clock wall|cpu]";
 
 }  // namespace
 
@@ -247,13 +265,16 @@ int main(int argc, char** argv) {
         std::printf("%s\n", USAGE);
         return 0;
     }
-    args.only({"--lib", "--threads", "--reps", "--modes", "--quality", "--build-threads", "--config", "--brute"});
+    args.only({"--lib", "--threads", "--reps", "--modes", "--quality", "--build-threads", "--config", "--brute",
+               "--clock"});
     if (args.positional.size() != 2) die(std::string("expected MESH RAYS; ") + USAGE);
     if (args.get("--lib", "embree") != "embree") die("--lib takes embree");
     unsigned hw = std::max(1u, std::thread::hardware_concurrency());
     unsigned threads = static_cast<unsigned>(args.get_int("--threads", hw, 1));
     long reps = args.get_int("--reps", 5, 1);
     long brute_n = args.get_int("--brute", 0, 0);
+    std::string clock = args.get("--clock", "wall");
+    if (clock != "wall" && clock != "cpu") die("--clock takes wall or cpu");
     std::string quality = args.get("--quality", "high");
     RTCBuildQuality q = quality == "high"     ? RTC_BUILD_QUALITY_HIGH
                         : quality == "medium" ? RTC_BUILD_QUALITY_MEDIUM
@@ -326,6 +347,7 @@ int main(int argc, char** argv) {
     std::printf("# device_config %s\n", cfg.empty() ? "default" : cfg.c_str());
     std::printf("# packet_width %d\n", width);
     std::printf("# threads 1 %u\n", threads);
+    std::printf("# clock %s\n", clock.c_str());
     // Each mode: `# ns_per_ray MODE median_1thread median_Kthreads`; rounds take
     // turns over the modes so that load from elsewhere hits them alike.
     std::vector<std::vector<double>> t1(modes.size()), tk(modes.size());
@@ -333,7 +355,7 @@ int main(int argc, char** argv) {
     for (long r = 0; r < reps; ++r) {
         for (size_t m = 0; m < modes.size(); ++m) {
             Kernel k = modes[m] == "single" ? run_single : modes[m] == "packet" ? packet : run_stream;
-            t1[m].push_back(pass(k, scene, rays, got, 1) / rays.size());
+            t1[m].push_back(pass(k, scene, rays, got, 1, clock == "cpu") / rays.size());
             for (size_t i = 0; i < rays.size(); ++i) mismatches += !(got[i] == ref[i]);
             tk[m].push_back(pass(k, scene, rays, got, threads) / rays.size());
             for (size_t i = 0; i < rays.size(); ++i) mismatches += !(got[i] == ref[i]);

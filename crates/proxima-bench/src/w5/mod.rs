@@ -1,25 +1,36 @@
 //! W5 mesh vs mesh [sources: w5, bvh]: each mesh pair at many relative poses,
-//! through every bounding-volume type with SAH trees, and parry3d's `TriMesh` as
-//! the peer.
+//! through every bounding-volume type with SAH trees, beside the peers: parry3d's
+//! `TriMesh`, and the C++ libraries FCL 0.7 and coal 3.0 with their OBBRSS and
+//! OBB trees ([`peers`], when `scripts/peers.sh` has built their harness).
 //!
 //! `proxima-bench w5 [--poses FILE] [--pairs rob-env,bunny,...] [--n N] [--seed S]
-//! [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall] [--json]`
+//! [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall]
+//! [--peers auto|none] [--peer-reps R] [--write-poses DIR] [--json]`
 //!
 //! - `rob-env` (FCL's test: rob.obj moving, env.obj fixed) uses the pose file
-//!   (default `data/rob-env-1000.poses`, FCL's distribution); the other pairs use
-//!   `--n` generated poses ([`poses::generate`]).
-//! - Per bounding volume: build time of both trees, mean and median time per
-//!   all-pairs and per first-contact query, the mean cost counters `Nv/Np/Nu` of
-//!   the all-pairs query, the intersecting triangle pairs summed over poses, and
-//!   the poses with a contact.
+//!   (default `data/rob-env-1000.poses`, FCL's distribution); `skin-ribcage`
+//!   (SKINbody moving around and into BONERibcage) 100 poses of
+//!   [`poses::generate_nested`]; the other pairs 300 poses of
+//!   [`poses::generate`] (`--n` sets the count of every generated pair).
+//! - Per bounding volume: build time of each tree, mean and median time per
+//!   all-pairs and per first-contact query and their ratios to the fastest peer
+//!   of the run (each statistic its own fastest), the mean cost counters
+//!   `Nv/Np/Nu` of the all-pairs query, the intersecting triangle pairs summed
+//!   over poses, and the poses with a contact. The same for every peer (the C++
+//!   peers' times are the harness's wall-clock figures over poses × `--peer-reps`).
+//! - `--write-poses DIR` also writes each pair's poses to `DIR/PAIR.poses` (for
+//!   `proxima collide --poses` and the peers' harness, e.g. under callgrind).
 //! - Checked in the same run (exit code 1 otherwise): every bounding volume finds
 //!   the same number of pairs on every pose; first contact hits iff all pairs is
 //!   non-empty; on the first `--brute` poses (fewer on big pairs, so that at most
 //!   ~10^8 triangle tests run; none on a pair above that) the pair sets equal brute force with the exact
-//!   test; every disagreement with parry is confirmed ours by the exact test.
+//!   test; every disagreement with parry is confirmed ours by the exact test; the
+//!   C++ peers find the same pairs and hits on every pose except for extra pairs
+//!   within their touching tolerance ([`peers::run_config`]).
 
 pub mod check;
 pub mod ours;
+pub mod peers;
 pub mod poses;
 
 use crate::parry_mesh::{self, ParryMeshes};
@@ -33,7 +44,7 @@ use std::fmt::Write as _;
 use std::process::ExitCode;
 use std::time::Duration;
 
-const USAGE: &str = "usage: proxima-bench w5 [--poses FILE] [--pairs rob-env,bunny,teapot,hand-forearm,skin-ribcage] [--n N] [--seed S] [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall] [--json]";
+const USAGE: &str = "usage: proxima-bench w5 [--poses FILE] [--pairs rob-env,bunny,teapot,hand-forearm,skin-ribcage] [--n N] [--seed S] [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall] [--peers auto|none] [--peer-reps R] [--write-poses DIR] [--json]";
 
 /// The mesh pairs: name, moving mesh, fixed mesh (files in `shared/data/`).
 const PAIRS: [(&str, &str, &str); 5] = [
@@ -43,7 +54,15 @@ const PAIRS: [(&str, &str, &str); 5] = [
     ("hand-forearm", "hand_3finger.stl", "forearm.stl"),
     ("skin-ribcage", "SKINbody.stl", "BONERibcage.stl"),
 ];
-const DEFAULT_PAIRS: &str = "rob-env,bunny,teapot,hand-forearm";
+const DEFAULT_PAIRS: &str = "rob-env,bunny,teapot,hand-forearm,skin-ribcage";
+/// Generated poses per pair (without `--n`): 300, and 100 for the big pair.
+fn default_n(pair: &str) -> usize {
+    if pair == "skin-ribcage" {
+        100
+    } else {
+        300
+    }
+}
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/");
 const DEFAULT_POSES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/rob-env-1000.poses");
 /// Cap on brute-force triangle tests per mesh pair.
@@ -51,24 +70,30 @@ const BRUTE_BUDGET: usize = 100_000_000;
 
 struct Args {
     poses: String,
+    write_poses: Option<String>,
     pairs: Vec<String>,
-    n: usize,
+    n: Option<usize>,
     seed: u64,
     brute: usize,
     rotation: RotationUpdate,
     clock: Clock,
+    peers: bool,
+    peer_reps: usize,
     json: bool,
 }
 
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     let mut a = Args {
         poses: DEFAULT_POSES.into(),
+        write_poses: None,
         pairs: DEFAULT_PAIRS.split(',').map(String::from).collect(),
-        n: 200,
+        n: None,
         seed: 5,
         brute: 20,
         rotation: RotationUpdate::Auto,
         clock: Clock::ThreadCpu,
+        peers: true,
+        peer_reps: 1,
         json: false,
     };
     let num = |s: String| {
@@ -80,6 +105,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         let mut value = |name: &str| it.next().ok_or(format!("{name} needs a value"));
         match flag.as_str() {
             "--poses" => a.poses = value("--poses")?,
+            "--write-poses" => a.write_poses = Some(value("--write-poses")?),
             "--pairs" => {
                 a.pairs = value("--pairs")?
                     .split(',')
@@ -94,7 +120,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                     return Err(format!("unknown mesh pair {p:?}"));
                 }
             }
-            "--n" => a.n = num(value("--n")?)? as usize,
+            "--n" => a.n = Some(num(value("--n")?)? as usize),
             "--seed" => a.seed = num(value("--seed")?)?,
             "--brute" => a.brute = num(value("--brute")?)? as usize,
             "--rotation" => {
@@ -110,6 +136,14 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                 }
             }
             "--clock" => a.clock = Clock::parse(&value("--clock")?)?,
+            "--peers" => {
+                a.peers = match value("--peers")?.as_str() {
+                    "auto" => true,
+                    "none" => false,
+                    o => return Err(format!("--peers takes auto or none, not {o:?}")),
+                }
+            }
+            "--peer-reps" => a.peer_reps = num(value("--peer-reps")?)?.max(1) as usize,
             "--json" => a.json = true,
             "-h" | "--help" => return Err(String::new()),
             o => return Err(format!("unknown argument {o:?}")),
@@ -136,6 +170,8 @@ struct PairRun {
     brute_poses: usize,
     bvs: Vec<BvRun>,
     parry: ParryRun,
+    /// The C++ peers, or why they did not run.
+    peers: Result<Vec<peers::PeerRun>, String>,
 }
 
 fn mean(d: &[Duration]) -> Duration {
@@ -158,18 +194,30 @@ fn run_pair(
     errors: &mut Vec<String>,
 ) -> Result<PairRun, String> {
     let (a, b) = (load(fa)?, load(fb)?);
-    let poses = if name == "rob-env" {
-        let text =
-            std::fs::read_to_string(&args.poses).map_err(|e| format!("{}: {e}", args.poses))?;
-        poses::parse(&args.poses, &text)?
-    } else {
-        poses::generate(&a, &b, args.n, args.seed)
+    let n = args.n.unwrap_or(default_n(name));
+    let poses = match name {
+        "rob-env" => {
+            let text =
+                std::fs::read_to_string(&args.poses).map_err(|e| format!("{}: {e}", args.poses))?;
+            poses::parse(&args.poses, &text)?
+        }
+        "skin-ribcage" => poses::generate_nested(&a, &b, n, args.seed),
+        _ => poses::generate(&a, &b, n, args.seed),
     };
+    if let Some(dir) = &args.write_poses {
+        let path = std::path::Path::new(dir).join(format!("{name}.poses"));
+        peers::write_poses(&path, &poses)?;
+        eprintln!("  {name}: wrote {}", path.display());
+    }
     let brute_poses = args
         .brute
         .min(BRUTE_BUDGET / (a.len() * b.len()))
         .min(poses.len());
-    let (c, k, r) = (args.clock, brute_poses, args.rotation);
+    let (c, k, r) = (
+        ours::QueryClock::new(args.clock),
+        brute_poses,
+        args.rotation,
+    );
     let mut bvs = Vec::new();
     for bv in ["aabb", "kdop14", "kdop18", "kdop26", "obb", "sphere"] {
         eprintln!("  {name}: {bv} ...");
@@ -216,13 +264,18 @@ fn run_pair(
         }
     }
     eprintln!("  {name}: parry3d ...");
-    let parry = run_parry(&a, &b, &poses, reference, args.clock)?;
+    let parry = run_parry(&a, &b, &poses, reference, c)?;
     if parry.d.unverified > 0 {
         errors.push(format!(
             "{name}: {} disagreements with parry not confirmed by the exact test",
             parry.d.unverified
         ));
     }
+    let peers = if args.peers {
+        run_peers((name, fa, fb), args, (&a, &b, &poses), reference, errors)
+    } else {
+        Err("--peers none".into())
+    };
     Ok(PairRun {
         name,
         tris: (a.len(), b.len()),
@@ -230,7 +283,50 @@ fn run_pair(
         brute_poses,
         bvs,
         parry,
+        peers,
     })
+}
+
+/// Runs every C++ peer configuration on the pair through its harness, or says why
+/// not (not built: an `Err` note, not a failure).
+fn run_peers(
+    (name, fa, fb): (&str, &str, &str),
+    args: &Args,
+    meshes: (&TriMesh, &TriMesh, &[Affine3A]),
+    ours: &BvRun,
+    errors: &mut Vec<String>,
+) -> Result<Vec<peers::PeerRun>, String> {
+    let Some(dir) = peers::harness_dir() else {
+        return Err("C++ peers not built (scripts/peers.sh builds them)".into());
+    };
+    let pose_file =
+        std::env::temp_dir().join(format!("proxima-w5-{}-{name}.poses", std::process::id()));
+    peers::write_poses(&pose_file, meshes.2)?;
+    let (pa, pb) = (format!("{DATA}{fa}"), format!("{DATA}{fb}"));
+    let mut out = Vec::new();
+    let mut result = Ok(());
+    for config in peers::CONFIGS {
+        eprintln!("  {name}: {} {} ...", config.0, config.1);
+        match peers::run_config(
+            &dir,
+            config,
+            (pa.as_ref(), pb.as_ref()),
+            &pose_file,
+            args.peer_reps,
+            meshes,
+            (&ours.counts, &ours.hits),
+            errors,
+        ) {
+            Ok(r) => out.push(r),
+            Err(e) => {
+                errors.push(format!("{name}: {e}"));
+                result = Err(format!("failed: {e}"));
+                break;
+            }
+        }
+    }
+    let _ = std::fs::remove_file(&pose_file);
+    result.map(|()| out)
 }
 
 fn run_parry(
@@ -238,9 +334,9 @@ fn run_parry(
     b: &TriMesh,
     poses: &[Affine3A],
     ours: &BvRun,
-    clock: Clock,
+    qc: ours::QueryClock,
 ) -> Result<ParryRun, String> {
-    let (meshes, build) = clock.time(|| ParryMeshes::build(a, b));
+    let (meshes, build) = qc.clock.time(|| ParryMeshes::build(a, b));
     let meshes = meshes?;
     let mut r = ParryRun {
         build,
@@ -258,11 +354,11 @@ fn run_parry(
     let mut col = proxima::narrow::Collider::<Obb>::default();
     for (i, p) in poses.iter().enumerate() {
         let pp = parry_mesh::pose(p);
-        let (hit, t) = clock.time(|| meshes.intersects(&pp));
+        let (hit, t) = qc.time(|| meshes.intersects(&pp));
         let hit = hit?;
         r.first.push(t);
         r.hits += hit as usize;
-        let (mut pairs, t) = clock.time(|| meshes.all_pairs(&pp));
+        let (mut pairs, t) = qc.time(|| meshes.all_pairs(&pp));
         r.all.push(t);
         r.pair_total += pairs.len() as u64;
         pairs.sort_unstable();
@@ -288,12 +384,62 @@ fn run_parry(
     Ok(r)
 }
 
+/// A peer's figures in the table's terms: name, build µs per tree, all pairs
+/// (median, mean µs), first contact (median, mean µs).
+struct PeerFigures {
+    name: String,
+    build_us: (f64, f64),
+    all: (f64, f64),
+    first: (f64, f64),
+}
+
+/// Every peer of a pair: parry, then the C++ peers that ran.
+fn peer_figures(p: &PairRun) -> Vec<PeerFigures> {
+    let pr = &p.parry;
+    let mut v = vec![PeerFigures {
+        name: "parry3d".into(),
+        // parry builds both meshes in one call: split evenly is not meaningful,
+        // so the whole build is shown under the first and none under the second.
+        build_us: (us(pr.build), 0.0),
+        all: (us(median(&pr.all)), us(mean(&pr.all))),
+        first: (us(median(&pr.first)), us(mean(&pr.first))),
+    }];
+    if let Ok(peers) = &p.peers {
+        v.extend(peers.iter().map(|r| PeerFigures {
+            name: r.name.clone(),
+            build_us: r.build_us,
+            all: r.all,
+            first: r.first,
+        }));
+    }
+    v
+}
+
+/// The fastest peer on one statistic: (value, name).
+fn fastest(peers: &[PeerFigures], stat: impl Fn(&PeerFigures) -> f64) -> (f64, String) {
+    peers
+        .iter()
+        .map(|p| (stat(p), p.name.clone()))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .unwrap_or((f64::NAN, String::new()))
+}
+
+/// The four denominators: all median, all mean, first median, first mean.
+fn denominators(p: &PairRun) -> [(f64, String); 4] {
+    let f = peer_figures(p);
+    [
+        fastest(&f, |x| x.all.0),
+        fastest(&f, |x| x.all.1),
+        fastest(&f, |x| x.first.0),
+        fastest(&f, |x| x.first.1),
+    ]
+}
+
 fn table(runs: &[PairRun], rotation: RotationUpdate, clock: Clock) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "w5 mesh vs mesh, SAH trees (leaf 1), rotation={:?}, clock={} (times per query; vs parry = our median / parry median; pair counts checked equal for every BV on every pose)", rotation, clock.name());
+    let _ = writeln!(s, "w5 mesh vs mesh, SAH trees (leaf 1), rotation={:?}, clock={} for ours and parry3d, wall for the C++ peers (their harness); times in µs per query (the clock's own cost beyond a wall-clock reading removed); /best = ours over the fastest peer of this run on that statistic; pair counts checked equal for every BV on every pose", rotation, clock.name());
     for p in runs {
-        let pr = &p.parry;
-        let (pa, pf) = (median(&pr.all), median(&pr.first));
+        let d = denominators(p);
         let _ = writeln!(
             s,
             "\n{} ({} x {} triangles, {} poses, brute-force checked on {}; contact on {} poses)",
@@ -306,51 +452,158 @@ fn table(runs: &[PairRun], rotation: RotationUpdate, clock: Clock) -> String {
         );
         let _ = writeln!(
             s,
-            "{:<8} {:>9} {:>10} {:>10} {:>8} {:>10} {:>10} {:>8} {:>9} {:>8} {:>7} {:>10}",
+            "fastest peers: all median {} ({:.1}), all mean {} ({:.1}), first median {} ({:.2}), first mean {} ({:.2})",
+            d[0].1, d[0].0, d[1].1, d[1].0, d[2].1, d[2].0, d[3].1, d[3].0
+        );
+        let _ = writeln!(
+            s,
+            "{:<12} {:>9} {:>9} {:>9} {:>9} {:>6} {:>6} {:>9} {:>9} {:>6} {:>6} {:>8} {:>7} {:>6} {:>10}",
             "bv",
-            "build ms",
-            "all mean",
+            "build A",
+            "build B",
             "all med",
-            "vs parry",
-            "first mean",
-            "first med",
-            "vs parry",
+            "all mean",
+            "/best",
+            "/best",
+            "1st med",
+            "1st mean",
+            "/best",
+            "/best",
             "Nv",
             "Np",
             "Nu",
             "pairs"
         );
         for r in &p.bvs {
-            let (am, fm) = (median(&r.all), median(&r.first));
-            let _ = writeln!(s, "{:<8} {:>9.2} {:>10.1} {:>10.1} {:>8.2} {:>10.1} {:>10.1} {:>8.2} {:>9.0} {:>8.0} {:>7.0} {:>10}", r.name, r.build.as_secs_f64() * 1e3, us(mean(&r.all)), us(am), us(am) / us(pa), us(mean(&r.first)), us(fm), us(fm) / us(pf), r.nv, r.np, r.nu, r.counts.iter().sum::<u64>());
+            let (am, aa) = (us(median(&r.all)), us(mean(&r.all)));
+            let (fm, fa) = (us(median(&r.first)), us(mean(&r.first)));
+            let _ = writeln!(
+                s,
+                "{:<12} {:>9.1} {:>9.1} {:>9.2} {:>9.2} {:>6.2} {:>6.2} {:>9.2} {:>9.2} {:>6.2} {:>6.2} {:>8.0} {:>7.0} {:>6.0} {:>10}",
+                r.name,
+                us(r.build.0),
+                us(r.build.1),
+                am,
+                aa,
+                am / d[0].0,
+                aa / d[1].0,
+                fm,
+                fa,
+                fm / d[2].0,
+                fa / d[3].0,
+                r.nv,
+                r.np,
+                r.nu,
+                r.counts.iter().sum::<u64>()
+            );
         }
-        let _ = writeln!(s, "{:<8} {:>9.2} {:>10.1} {:>10.1} {:>8} {:>10.1} {:>10.1} {:>8} {:>9} {:>8} {:>7} {:>10}", "parry", pr.build.as_secs_f64() * 1e3, us(mean(&pr.all)), us(pa), "1.00", us(mean(&pr.first)), us(pf), "1.00", "-", "-", "-", pr.pair_total);
+        for f in peer_figures(p) {
+            let (pairs, hits) = if f.name == "parry3d" {
+                (p.parry.pair_total, p.parry.hits)
+            } else {
+                let r = p
+                    .peers
+                    .as_ref()
+                    .ok()
+                    .and_then(|v| v.iter().find(|r| r.name == f.name));
+                r.map_or((0, 0), |r| {
+                    (r.counts.iter().sum(), r.hits.iter().filter(|&&h| h).count())
+                })
+            };
+            let _ = writeln!(
+                s,
+                "{:<12} {:>9.1} {:>9} {:>9.2} {:>9.2} {:>6} {:>6} {:>9.2} {:>9.2} {:>6} {:>6} {:>8} {:>7} {:>6} {:>10}  hits {}",
+                f.name,
+                f.build_us.0,
+                if f.name == "parry3d" { "-".to_string() } else { format!("{:.1}", f.build_us.1) },
+                f.all.0,
+                f.all.1,
+                "",
+                "",
+                f.first.0,
+                f.first.1,
+                "",
+                "",
+                "-",
+                "-",
+                "-",
+                pairs,
+                hits
+            );
+        }
+        let pr = &p.parry;
         let _ = writeln!(s, "parry disagreements (each confirmed ours by the exact test): {} poses first-contact, {} pairs only parry ({} of them apart by parry's own distance query, largest gap {:.2e}), {} pairs only ours", pr.d.bool_poses, pr.d.parry_only, pr.d.parry_only_apart, pr.d.parry_only_max_gap, pr.d.ours_only);
+        match &p.peers {
+            Ok(v) => {
+                for r in v {
+                    let _ = writeln!(
+                        s,
+                        "{} ({}): answers equal to ours on every pose{}",
+                        r.name,
+                        r.version,
+                        if r.tolerance_poses == 0 {
+                            String::new()
+                        } else {
+                            format!(
+                                " but {} where it adds {} pairs within its touching tolerance (checked)",
+                                r.tolerance_poses, r.tolerance_pairs
+                            )
+                        }
+                    );
+                }
+            }
+            Err(note) => {
+                let _ = writeln!(s, "C++ peers: {note}");
+            }
+        }
     }
     s
 }
 
 fn json(runs: &[PairRun], clock: Clock) -> String {
     let mut s = format!(
-        "{{\"workload\":\"w5\",\"clock\":\"{}\",\"pairs\":[",
+        "{{\"workload\":\"w5\",\"clock\":\"{}\",\"peer_clock\":\"wall\",\"pairs\":[",
         clock.name()
     );
     for (i, p) in runs.iter().enumerate() {
         let pr = &p.parry;
+        let d = denominators(p);
         let _ = write!(
             s,
-            "{}{{\"name\":\"{}\",\"triangles\":[{},{}],\"poses\":{},\"brute_poses\":{},\"bvs\":[",
+            "{}{{\"name\":\"{}\",\"triangles\":[{},{}],\"poses\":{},\"brute_poses\":{},\"fastest_peer\":{{\"all_median\":\"{}\",\"all_mean\":\"{}\",\"first_median\":\"{}\",\"first_mean\":\"{}\"}},\"bvs\":[",
             if i > 0 { "," } else { "" },
             p.name,
             p.tris.0,
             p.tris.1,
             p.poses,
-            p.brute_poses
+            p.brute_poses,
+            d[0].1,
+            d[1].1,
+            d[2].1,
+            d[3].1
         );
         for (j, r) in p.bvs.iter().enumerate() {
-            let _ = write!(s, "{}{{\"bv\":\"{}\",\"build_ms\":{:.3},\"all_mean_us\":{:.2},\"all_median_us\":{:.2},\"first_mean_us\":{:.2},\"first_median_us\":{:.2},\"nv\":{:.1},\"np\":{:.1},\"nu\":{:.1},\"pairs\":{},\"hits\":{}}}", if j > 0 { "," } else { "" }, r.name, r.build.as_secs_f64() * 1e3, us(mean(&r.all)), us(median(&r.all)), us(mean(&r.first)), us(median(&r.first)), r.nv, r.np, r.nu, r.counts.iter().sum::<u64>(), r.hits.iter().filter(|&&h| h).count());
+            let (am, aa) = (us(median(&r.all)), us(mean(&r.all)));
+            let (fm, fa) = (us(median(&r.first)), us(mean(&r.first)));
+            let _ = write!(s, "{}{{\"bv\":\"{}\",\"build_ms\":[{:.3},{:.3}],\"all_mean_us\":{:.3},\"all_median_us\":{:.3},\"first_mean_us\":{:.3},\"first_median_us\":{:.3},\"all_median_vs_best\":{:.4},\"all_mean_vs_best\":{:.4},\"first_median_vs_best\":{:.4},\"first_mean_vs_best\":{:.4},\"nv\":{:.1},\"np\":{:.1},\"nu\":{:.1},\"pairs\":{},\"hits\":{}}}", if j > 0 { "," } else { "" }, r.name, us(r.build.0) / 1e3, us(r.build.1) / 1e3, aa, am, fa, fm, am / d[0].0, aa / d[1].0, fm / d[2].0, fa / d[3].0, r.nv, r.np, r.nu, r.counts.iter().sum::<u64>(), r.hits.iter().filter(|&&h| h).count());
         }
-        let _ = write!(s, "],\"parry\":{{\"build_ms\":{:.3},\"all_mean_us\":{:.2},\"all_median_us\":{:.2},\"first_mean_us\":{:.2},\"first_median_us\":{:.2},\"pairs\":{},\"hits\":{},\"bool_disagreements\":{},\"parry_only_pairs\":{},\"parry_only_max_gap\":{:e},\"ours_only_pairs\":{}}}}}", pr.build.as_secs_f64() * 1e3, us(mean(&pr.all)), us(median(&pr.all)), us(mean(&pr.first)), us(median(&pr.first)), pr.pair_total, pr.hits, pr.d.bool_poses, pr.d.parry_only, pr.d.parry_only_max_gap, pr.d.ours_only);
+        let _ = write!(s, "],\"parry\":{{\"build_ms\":{:.3},\"all_mean_us\":{:.3},\"all_median_us\":{:.3},\"first_mean_us\":{:.3},\"first_median_us\":{:.3},\"pairs\":{},\"hits\":{},\"bool_disagreements\":{},\"parry_only_pairs\":{},\"parry_only_max_gap\":{:e},\"ours_only_pairs\":{}}}", pr.build.as_secs_f64() * 1e3, us(mean(&pr.all)), us(median(&pr.all)), us(mean(&pr.first)), us(median(&pr.first)), pr.pair_total, pr.hits, pr.d.bool_poses, pr.d.parry_only, pr.d.parry_only_max_gap, pr.d.ours_only);
+        match &p.peers {
+            Ok(v) => {
+                s.push_str(",\"peers\":[");
+                for (j, r) in v.iter().enumerate() {
+                    let _ = write!(s, "{}{{\"peer\":\"{}\",\"version\":\"{}\",\"build_ms\":[{:.3},{:.3}],\"all_median_us\":{:.3},\"all_mean_us\":{:.3},\"first_median_us\":{:.3},\"first_mean_us\":{:.3},\"pairs\":{},\"hits\":{},\"tolerance_poses\":{},\"tolerance_pairs\":{}}}", if j > 0 { "," } else { "" }, r.name, r.version, r.build_us.0 / 1e3, r.build_us.1 / 1e3, r.all.0, r.all.1, r.first.0, r.first.1, r.counts.iter().sum::<u64>(), r.hits.iter().filter(|&&h| h).count(), r.tolerance_poses, r.tolerance_pairs);
+                }
+                s.push_str("]}");
+            }
+            Err(note) => {
+                let _ = write!(
+                    s,
+                    ",\"peers\":null,\"peers_note\":\"{}\"}}",
+                    note.replace('"', "'")
+                );
+            }
+        }
     }
     s.push_str("]}\n");
     s

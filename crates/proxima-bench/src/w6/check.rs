@@ -16,6 +16,16 @@ const EDGE: f64 = 1e-4;
 /// A peer disagreeing on more than this fraction of the rays fails the run.
 const MAX_PEER_DISAGREEMENT: f64 = 0.01;
 
+/// How close a peer's `t` must be to ours (the triangle may differ: a tie).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tol {
+    /// Within `T_TOL` of `t` plus the mesh's size: the Rust peers.
+    Scene,
+    /// Within this fraction of `t`, or (for `t` near 0, where `f32` rounding of
+    /// the coordinates dominates) within 64 ε of the mesh's size: Embree.
+    Relative(f32),
+}
+
 /// How one structure's answers compare with the reference.
 #[derive(Clone, Debug, Default)]
 pub struct Verdict {
@@ -82,20 +92,37 @@ impl<'a> Verifier<'a> {
         }
     }
 
-    fn agree(&self, a: Option<(u32, f32)>, b: Option<(u32, f32)>) -> bool {
+    fn agree(&self, a: Option<(u32, f32)>, b: Option<(u32, f32)>, tol: Tol) -> bool {
         match (a, b) {
             (None, None) => true,
-            (Some((_, s)), Some((_, t))) => (s - t).abs() <= T_TOL * (s.abs() + self.scale),
+            (Some((_, s)), Some((_, t))) => match tol {
+                Tol::Scene => (s - t).abs() <= T_TOL * (s.abs() + self.scale),
+                Tol::Relative(r) => {
+                    (s - t).abs() <= r * s.abs().max(t.abs()) + 64.0 * f32::EPSILON * self.scale
+                }
+            },
             _ => false,
         }
     }
 
-    /// Checks the answers `res` of structure `name` (for the first `res.len()` rays).
+    /// Checks the answers `res` of structure `name` (for the first `res.len()` rays),
+    /// a peer's within [`Tol::Scene`].
     pub fn check(
         &mut self,
         name: &'static str,
         peer: bool,
         res: &[Option<(u32, f32)>],
+    ) -> Result<Verdict, String> {
+        self.check_within(name, peer, res, Tol::Scene)
+    }
+
+    /// [`Verifier::check`] with the peer tolerance `tol`.
+    pub fn check_within(
+        &mut self,
+        name: &'static str,
+        peer: bool,
+        res: &[Option<(u32, f32)>],
+        tol: Tol,
     ) -> Result<Verdict, String> {
         let Some((ref_name, reference)) = &self.reference else {
             if peer {
@@ -115,7 +142,7 @@ impl<'a> Verifier<'a> {
                 }
                 continue;
             }
-            if self.agree(got, want) {
+            if self.agree(got, want, tol) {
                 continue;
             }
             v.disagree += 1;

@@ -1,6 +1,7 @@
 //! W6, rays vs one mesh [sources: w6]: `proxima-bench w6 [--mesh NAME,NAME]
 //! [--rays R] [--threads 1,2] [--repeats N] [--leaf L] [--seed S] [--only A,B]
-//! [--clock cpu|wall] [--json]`.
+//! [--clock cpu|wall] [--json] [--no-embree] [--rays-out DIR]` (`--rays-out`
+//! writes each mesh's rays to `DIR/MESH.rays` in the harness's format).
 //!
 //! For each mesh of `shared/data` (or `--mesh`), R rays ([`rays::rays`]) go through
 //! every structure ([`structures::entries`]): build time, median time per ray over
@@ -11,24 +12,39 @@
 //! structures must agree exactly with each other and with brute force (on a subset,
 //! and on every ray a peer disagrees on); peers may differ on grazing rays (their
 //! `f32` Möller tests are not watertight), and those rays are counted.
+//!
+//! Embree runs in the same run when `scripts/peers.sh` built its harness
+//! ([`embree`]; a note otherwise): its answers are checked like a peer's (hit/miss
+//! equal, `t` within 1e-5 relative, another triangle allowed at an equal `t`), and
+//! its fastest mode on one thread and on K threads (each `--threads` value) and its
+//! build time (Embree's own threads) sit in the table; `vs embree` divides our time
+//! per ray by its fastest one-thread mode, `par vs embree` our batch on the most
+//! threads by its fastest mode on as many.
 
 pub mod bvh_peer;
 pub mod caster;
 pub mod check;
+pub mod embree;
 pub mod obvhs_peer;
 pub mod parry_mesh_peer;
 pub mod rays;
 pub mod structures;
 
 use crate::run::{median, num, Clock};
-use check::{Verdict, Verifier};
+use check::{Tol, Verdict, Verifier};
 use proxima::geom::Ray;
 use proxima::narrow::{BuildOptions, SplitRule, TriMesh};
 use std::fmt::Write;
 use std::process::ExitCode;
 use std::time::Duration;
 
-const USAGE: &str = "usage: proxima-bench w6 [--mesh NAME,NAME] [--rays R] [--threads 1,2] [--repeats N] [--leaf L] [--seed S] [--only A,B] [--clock cpu|wall] [--json]";
+const USAGE: &str = "usage: proxima-bench w6 [--mesh NAME,NAME] [--rays R] [--threads 1,2] [--repeats N] [--leaf L] [--seed S] [--only A,B] [--clock cpu|wall] [--json] [--no-embree] [--rays-out DIR]";
+
+/// The Embree row's name.
+pub const EMBREE: &str = "embree";
+/// Relative tolerance on Embree's `t` (the brief's; its `f32` Möller test vs our
+/// exact one).
+const EMBREE_T_TOL: f32 = 1e-5;
 
 /// The default meshes (`shared/data`).
 pub const MESHES: [&str; 5] = [
@@ -52,6 +68,8 @@ struct Args {
     only: Vec<String>,
     clock: Clock,
     json: bool,
+    embree: bool,
+    rays_out: Option<String>,
 }
 
 fn list(s: &str) -> Vec<String> {
@@ -72,6 +90,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         only: Vec::new(),
         clock: Clock::ThreadCpu,
         json: false,
+        embree: true,
+        rays_out: None,
     };
     while let Some(flag) = it.next() {
         let mut value = |name: &str| it.next().ok_or(format!("{name} needs a value"));
@@ -90,6 +110,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--only" => a.only = list(&value("--only")?),
             "--clock" => a.clock = Clock::parse(&value("--clock")?)?,
             "--json" => a.json = true,
+            "--no-embree" => a.embree = false,
+            "--rays-out" => a.rays_out = Some(value("--rays-out")?),
             "-h" | "--help" => return Err(String::new()),
             o => return Err(format!("unknown argument {o:?}")),
         }
@@ -118,14 +140,79 @@ pub struct Row {
     pub hits: usize,
     /// The agreement check.
     pub verdict: Verdict,
+    /// For Embree: its modes' times per ray, one line.
+    pub note: Option<String>,
 }
 
 fn per_ray(d: Duration, n: usize) -> Duration {
     d / n.max(1) as u32
 }
 
-fn run_mesh(a: &Args, mesh: &TriMesh, out: &mut Vec<Row>) -> Result<(), String> {
+/// Embree's row (its harness on the mesh file `path`, once per thread count), or
+/// `None` when its harness is not built or `--only` leaves it out.
+fn embree_row(
+    a: &Args,
+    path: &str,
+    rays: &[Ray],
+    verifier: &mut Verifier,
+) -> Result<Option<Row>, String> {
+    if !a.embree || !(a.only.is_empty() || a.only.iter().any(|o| o == EMBREE)) {
+        return Ok(None);
+    }
+    let Some(bin) = embree::find() else {
+        eprintln!("  embree: no harness (scripts/peers.sh builds it); column left out");
+        return Ok(None);
+    };
+    eprintln!("  {EMBREE} ({}) ...", bin.display());
+    let cpu = a.clock == Clock::ThreadCpu;
+    let mut first: Option<embree::EmbreeRun> = None;
+    let mut par = Vec::new();
+    let mut notes = Vec::new();
+    for &k in &a.threads {
+        let r = embree::run(&bin, path, rays, k, a.repeats, cpu)?;
+        let many = r.best_many().ok_or("w6_rays: no modes")?;
+        par.push((k, many.many));
+        notes.push(format!("{k}T {}", many.name));
+        if first.is_none() {
+            first = Some(r);
+        }
+    }
+    let Some(r) = first else { return Ok(None) };
+    let best = r.best_one().ok_or("w6_rays: no modes")?;
+    let modes: Vec<String> = r
+        .modes
+        .iter()
+        .map(|m| format!("{} {:.3}/{:.3}", m.name, us(m.one), us(m.many)))
+        .collect();
+    let verdict = verifier.check_within(EMBREE, true, &r.answers, Tol::Relative(EMBREE_T_TOL))?;
+    Ok(Some(Row {
+        name: EMBREE,
+        peer: true,
+        rays: rays.len(),
+        build: r.build,
+        per_ray: best.one,
+        par,
+        hits: r.answers.iter().filter(|h| h.is_some()).count(),
+        verdict,
+        note: Some(format!(
+            "{}: fastest on 1 thread: {}; on K threads: {}; us/ray 1T/{}T per mode: {}; build on Embree's own threads",
+            r.lib,
+            best.name,
+            notes.join(", "),
+            r.threads,
+            modes.join(", ")
+        )),
+    }))
+}
+
+fn run_mesh(a: &Args, path: &str, mesh: &TriMesh, out: &mut Vec<Row>) -> Result<(), String> {
     let rays = rays::rays(mesh, a.rays, a.seed);
+    if let Some(dir) = &a.rays_out {
+        // The ray set in the harness's format, to profile a peer on it alone.
+        let stem = path.rsplit('/').next().unwrap_or(path);
+        let file = format!("{dir}/{stem}.rays");
+        std::fs::write(&file, embree::encode(&rays)).map_err(|e| format!("{file}: {e}"))?;
+    }
     let brute_n = BRUTE_RAYS.min(rays.len());
     let opts = BuildOptions {
         split: SplitRule::Sah,
@@ -191,7 +278,11 @@ fn run_mesh(a: &Args, mesh: &TriMesh, out: &mut Vec<Row>) -> Result<(), String> 
             par,
             hits: res.iter().filter(|h| h.is_some()).count(),
             verdict,
+            note: None,
         });
+    }
+    if let Some(row) = embree_row(a, path, &rays, &mut verifier)? {
+        out.push(row);
     }
     Ok(())
 }
@@ -200,13 +291,31 @@ fn us(d: Duration) -> f64 {
     d.as_secs_f64() * 1e6
 }
 
-fn ratio(r: &Row, rows: &[Row]) -> Option<f64> {
-    let o = rows.iter().find(|x| x.name == structures::OBVHS)?;
+fn ratio_to(r: &Row, rows: &[Row], peer: &str) -> Option<f64> {
+    let o = rows.iter().find(|x| x.name == peer)?;
     (o.per_ray > Duration::ZERO).then(|| us(r.per_ray) / us(o.per_ray))
+}
+
+fn ratio(r: &Row, rows: &[Row]) -> Option<f64> {
+    ratio_to(r, rows, structures::OBVHS)
+}
+
+/// Our batch on `k` threads over Embree's fastest mode on as many.
+fn par_ratio(r: &Row, rows: &[Row], k: usize) -> Option<f64> {
+    let e = rows.iter().find(|x| x.name == EMBREE)?;
+    let ours = r.par.iter().find(|p| p.0 == k)?.1;
+    let theirs = e.par.iter().find(|p| p.0 == k)?.1;
+    (theirs > Duration::ZERO).then(|| us(ours) / us(theirs))
+}
+
+fn fmt_ratio(x: Option<f64>) -> String {
+    x.map_or("-".into(), |x| format!("{x:.2}x"))
 }
 
 fn table(rows: &[Row], threads: &[usize]) -> String {
     let mut s = String::new();
+    let kmax = threads.iter().copied().max().unwrap_or(1);
+    let embree = rows.iter().any(|r| r.name == EMBREE);
     let _ = write!(
         s,
         "{:<16} {:>9} {:>8} {:>9}",
@@ -215,7 +324,11 @@ fn table(rows: &[Row], threads: &[usize]) -> String {
     for k in threads {
         let _ = write!(s, " {:>9}", format!("par{k}T"));
     }
-    let _ = writeln!(s, " {:>8} {:>9} {:>9}", "hits", "disagree", "vs obvhs");
+    let _ = write!(s, " {:>8} {:>9} {:>9}", "hits", "disagree", "vs obvhs");
+    if embree {
+        let _ = write!(s, " {:>9} {:>11}", "vs embree", format!("par{kmax}T vs e"));
+    }
+    let _ = writeln!(s);
     for r in rows {
         let _ = write!(
             s,
@@ -235,8 +348,18 @@ fn table(rows: &[Row], threads: &[usize]) -> String {
                 }
             }
         }
-        let ratio = ratio(r, rows).map_or("-".into(), |x| format!("{x:.2}x"));
-        let _ = writeln!(s, " {:>8} {:>9} {:>9}", r.hits, r.verdict.disagree, ratio);
+        let ratio = fmt_ratio(ratio(r, rows));
+        let _ = write!(s, " {:>8} {:>9} {:>9}", r.hits, r.verdict.disagree, ratio);
+        if embree {
+            let e = fmt_ratio(ratio_to(r, rows, EMBREE));
+            let _ = write!(s, " {:>9} {:>11}", e, fmt_ratio(par_ratio(r, rows, kmax)));
+        }
+        let _ = writeln!(s);
+    }
+    for r in rows {
+        if let Some(n) = &r.note {
+            let _ = writeln!(s, "  {}", n);
+        }
     }
     for r in rows.iter().filter(|r| r.verdict.disagree > 0) {
         let _ = writeln!(s, "  {}: {}", r.name, r.verdict.explain());
@@ -244,7 +367,9 @@ fn table(rows: &[Row], threads: &[usize]) -> String {
     s
 }
 
-fn json(mesh: &str, rows: &[Row], out: &mut String) {
+fn json(mesh: &str, rows: &[Row], threads: &[usize], out: &mut String) {
+    let kmax = threads.iter().copied().max().unwrap_or(1);
+    let js = |x: Option<f64>| x.map_or("null".into(), |x| format!("{x:.4}"));
     for r in rows {
         let par: Vec<String> = r
             .par
@@ -253,7 +378,7 @@ fn json(mesh: &str, rows: &[Row], out: &mut String) {
             .collect();
         let _ = writeln!(
             out,
-            "{{\"workload\": \"w6\", \"mesh\": \"{mesh}\", \"structure\": \"{}\", \"peer\": {}, \"rays\": {}, \"build_ms\": {:.4}, \"us_per_ray\": {:.4}, \"par_us_per_ray\": {{{}}}, \"hits\": {}, \"disagree\": {}, \"vs_obvhs\": {}}},",
+            "{{\"workload\": \"w6\", \"mesh\": \"{mesh}\", \"structure\": \"{}\", \"peer\": {}, \"rays\": {}, \"build_ms\": {:.4}, \"us_per_ray\": {:.4}, \"par_us_per_ray\": {{{}}}, \"hits\": {}, \"disagree\": {}, \"vs_obvhs\": {}, \"vs_embree\": {}, \"par_vs_embree\": {}, \"note\": {:?}}},",
             r.name,
             r.peer,
             r.rays,
@@ -262,7 +387,10 @@ fn json(mesh: &str, rows: &[Row], out: &mut String) {
             par.join(", "),
             r.hits,
             r.verdict.disagree,
-            ratio(r, rows).map_or("null".into(), |x| format!("{x:.4}"))
+            js(ratio(r, rows)),
+            js(ratio_to(r, rows, EMBREE)),
+            js(par_ratio(r, rows, kmax)),
+            r.note.as_deref().unwrap_or("")
         );
     }
 }
@@ -300,12 +428,12 @@ pub fn main(args: impl Iterator<Item = String>) -> ExitCode {
         };
         eprintln!("{name} ({} triangles):", mesh.len());
         let mut rows = Vec::new();
-        if let Err(e) = run_mesh(&a, &mesh, &mut rows) {
+        if let Err(e) = run_mesh(&a, &path, &mesh, &mut rows) {
             eprintln!("W6 CHECK FAILED on {name}: {e}");
             return ExitCode::from(1);
         }
         if a.json {
-            json(name, &rows, &mut js);
+            json(name, &rows, &a.threads, &mut js);
         } else {
             println!(
                 "w6 {name} tris={} rays={} seed={} leaf={} clock={} (us/ray: median of {} on one thread; parKT: rayon batch on K threads, wall)",

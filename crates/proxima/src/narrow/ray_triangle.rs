@@ -85,8 +85,9 @@ pub(crate) struct WoopRay {
 }
 
 impl WoopRay {
-    /// Prepares `ray` (a valid ray).
-    #[inline]
+    /// Prepares `ray` (a valid ray). Never inlined: the casts build it lazily, at
+    /// most once per ray, and inlined its setup was hoisted into their loops.
+    #[inline(never)]
     pub(crate) fn new(ray: &Ray) -> WoopRay {
         let d = ray.dir.as_dvec3();
         // kz: the dominant axis of the direction; kx, ky keep the winding.

@@ -457,3 +457,99 @@ fn huge_coordinates_cast_with_every_volume() {
         cast_all::<Sphere>(&m, &rays, &wants);
     }
 }
+
+/// [`RayBvh`]'s descent is specialised per octant of the ray direction, with the
+/// slab sides and the widened inverse direction chosen per ray; rays with a zero
+/// or subnormal direction component and one-leaf trees take the general path.
+/// Against brute force: every octant (with components as small as `1e-30`,
+/// inverse `1e30`), zero and subnormal components, rays along the faces of the
+/// node boxes (through and along a vertex's coordinate planes, where the slab
+/// test's entry equals its exit), rays starting on a box face, and meshes of one
+/// to five triangles (one leaf with `leaf_size` 8).
+#[test]
+fn ray_bvh_every_octant_grazing_box_faces_and_one_leaf_trees() {
+    let mut rng = Pcg64::seed_from_u64(41);
+    let teapot = data("teapot.obj");
+    let mut meshes = vec![soup(300, 40)];
+    for n in 1..=5 {
+        // The first n triangles of the teapot (a patch), all its vertices.
+        let t = teapot.triangles()[..n].to_vec();
+        meshes.push(TriMesh::new(teapot.vertices().to_vec(), t).unwrap());
+    }
+    meshes.push(teapot);
+    for (mi, m) in meshes.iter().enumerate() {
+        // The box of the triangles (a patch uses few of the vertices).
+        let (lo, hi) = (0..m.len())
+            .flat_map(|i| m.triangle(i))
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), v| {
+                (l.min(v), h.max(v))
+            });
+        let (c, r) = ((lo + hi) * 0.5, (hi - lo).length().max(1e-3));
+        let mut rays = Vec::new();
+        for i in 0..1600 {
+            let tri = m.triangle(rng.gen_range(0..m.len()));
+            let corner = tri[rng.gen_range(0..3)];
+            // A direction in octant `i % 8`, some components tiny, zero or
+            // subnormal (one at least 0.05, so that hits stay at finite `t`).
+            let mut d = Vec3::new(
+                rng.gen_range(0.05..1.0),
+                rng.gen_range(0.05..1.0),
+                rng.gen_range(0.05..1.0),
+            );
+            let keep = rng.gen_range(0..3);
+            for a in 0..3 {
+                match rng.gen_range(0..10) {
+                    _ if a == keep => {}
+                    0 => d[a] = 1e-30,
+                    1 => d[a] = 0.0,
+                    2 => d[a] = 1e-40,
+                    _ => {}
+                }
+                if (i % 8) >> a & 1 == 1 {
+                    d[a] = -d[a];
+                }
+            }
+            let ray = match (i / 8) % 4 {
+                // Through a vertex from far away.
+                0 => Ray::new(corner - d * (3.0 * r), d),
+                // Starting on a vertex (on the faces of the boxes around it).
+                1 => Ray::new(corner, d),
+                // In a coordinate plane of a vertex (a box face), from outside.
+                2 => {
+                    let a = rng.gen_range(0..3);
+                    let mut d = d;
+                    d[a] = 0.0;
+                    if d.abs().max_element() < 0.05 {
+                        let b = (a + 1) % 3;
+                        d[b] = if d[b] < 0.0 { -0.5 } else { 0.5 };
+                    }
+                    let mut o = c - d * (3.0 * r);
+                    o[a] = corner[a];
+                    Ray::new(o, d)
+                }
+                // From a random point of the box, bounded or not.
+                _ => {
+                    let o = lo + (hi - lo) * Vec3::new(rng.gen(), rng.gen(), rng.gen());
+                    let max_t = if i % 3 == 0 {
+                        rng.gen_range(0.0..r)
+                    } else {
+                        f32::INFINITY
+                    };
+                    Ray::with_max_t(o, d, max_t)
+                }
+            };
+            rays.push(ray);
+        }
+        let wants: Vec<_> = rays.iter().map(|r| brute(m, r)).collect();
+        let hits = wants.iter().filter(|w| w.is_some()).count();
+        assert!(hits > 100, "mesh {mi}: {hits} hits");
+        for leaf in [1, 4, 8] {
+            let o = BuildOptions {
+                split: SplitRule::Sah,
+                leaf_size: leaf,
+            };
+            let t = RayBvh::build(m, o).unwrap();
+            check_ray_bvh(m, &t, &rays, &wants, &format!("mesh {mi} {o:?}"));
+        }
+    }
+}

@@ -3,7 +3,7 @@
 use super::{clip_slab, wide_gap, BoundingVolume};
 use crate::geom::Ray;
 use crate::{Error, Result};
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, Mat3A, Vec3, Vec3A};
 
 /// A k-DOP: the intersection of `K/2` slabs `min_i <= dot(axis_i, p) <= max_i` with
 /// fixed integer axes, as in the source (Klosowski et al.) [sources: kdop]:
@@ -74,6 +74,29 @@ fn project13(p: Vec3) -> [f32; 13] {
     ]
 }
 
+/// `Rᵀ axis_k` for axis `k` of [`AXES`], given `rows = Rᵀ` (whose columns are the
+/// rows of `R`): `Rᵀ (a, b, c) = a·row0 + b·row1 + c·row2` with `a, b, c` in
+/// `{-1, 0, 1}`, written as sums.
+#[inline(always)]
+fn rotated_axis(rows: &Mat3A, k: usize) -> Vec3A {
+    let (x, y, z) = (rows.x_axis, rows.y_axis, rows.z_axis);
+    match k {
+        0 => x,
+        1 => y,
+        2 => z,
+        3 => x + y + z,
+        4 => x - y + z,
+        5 => x + y - z,
+        6 => x - y - z,
+        7 => x + y,
+        8 => x + z,
+        9 => y + z,
+        10 => x - y,
+        11 => x - z,
+        _ => y - z,
+    }
+}
+
 /// `min` without NaN handling (inputs are finite): one instruction.
 #[inline(always)]
 fn fmin(a: f32, b: f32) -> f32 {
@@ -142,6 +165,17 @@ impl<const K: usize> Kdop<K> {
                 index: i,
                 len: Self::H,
             })
+        }
+    }
+
+    /// `1 / |axis_i|`: 1 for the coordinate axes, `1/√3` for the corner
+    /// diagonals, `1/√2` for the edge diagonals (slab widths in length units).
+    #[inline(always)]
+    const fn inv_len(i: usize) -> f32 {
+        match Self::axis_index(i) {
+            0..=2 => 1.0,
+            3..=6 => 0.577_350_26,
+            _ => std::f32::consts::FRAC_1_SQRT_2,
         }
     }
 
@@ -282,22 +316,25 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
     /// Bounds the rotated AABB part of the k-DOP (its first 3 slabs): along each
     /// axis `u`, the support of a box of centre `c` and half-extents `e` rotated by
     /// `R` is `u·(Rc + t) ± |Rᵀu|·e`. O(K), conservative.
+    ///
+    /// `Rᵀu` for the integer axes is a sum of rows of `R` ([`rotated_axis`]): no
+    /// matrix product per slab (this runs once per visited node of a rotated
+    /// moving tree).
+    #[inline]
     fn transformed(&self, pose: &Affine3A) -> Self {
-        let lo = Vec3::new(self.d[0], self.d[1], self.d[2]);
-        let hi = Vec3::new(self.d[Self::H], self.d[Self::H + 1], self.d[Self::H + 2]);
+        let h = Self::H;
+        let lo = Vec3A::new(self.d[0], self.d[1], self.d[2]);
+        let hi = Vec3A::new(self.d[h], self.d[h + 1], self.d[h + 2]);
         let c = (lo + hi) * 0.5;
         let e = (hi - lo) * 0.5;
-        let rt = pose.matrix3.transpose();
-        let wc = pose.transform_point3(c);
-        let pc = project13(wc);
+        let pc = project13(Vec3::from(pose.transform_point3a(c)));
+        let rows = pose.matrix3.transpose();
         let mut d = [0.0; K];
-        for i in 0..Self::H {
-            let u = Self::slab_axis(i);
-            let v = Vec3::from(rt * glam::Vec3A::from(u));
-            let r = v.abs().dot(e);
-            let m = pc[Self::axis_index(i)];
-            d[i] = m - r;
-            d[i + Self::H] = m + r;
+        for i in 0..h {
+            let k = Self::axis_index(i);
+            let r = rotated_axis(&rows, k).abs().dot(e);
+            d[i] = pc[k] - r;
+            d[i + h] = pc[k] + r;
         }
         Kdop { d }
     }
@@ -322,6 +359,43 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
             sep |= o.d[i] > self.d[i + Self::H] + m.d[i + Self::H];
         }
         !sep
+    }
+
+    /// The smallest overlap of the slab intervals, `min(max) - max(min)` per slab
+    /// scaled by `1/|axis|`, or `-1` when a slab separates (the same comparisons
+    /// as [`BoundingVolume::overlaps`]).
+    #[inline]
+    fn overlap_depth(&self, m: &Self::Motion, o: &Self) -> f32 {
+        let h = Self::H;
+        let (mut depth, mut sep) = (f32::INFINITY, false);
+        for i in 0..h {
+            let lo = fmax(self.d[i] + m.d[i], o.d[i]);
+            let hi = fmin(self.d[i + h] + m.d[i + h], o.d[i + h]);
+            sep |= lo > hi;
+            depth = fmin(depth, (hi - lo) * Self::inv_len(i));
+        }
+        if sep {
+            -1.0
+        } else {
+            depth
+        }
+    }
+
+    #[inline]
+    fn overlap_depth_fixed(&self, o: &Self) -> f32 {
+        let h = Self::H;
+        let (mut depth, mut sep) = (f32::INFINITY, false);
+        for i in 0..h {
+            let lo = fmax(self.d[i], o.d[i]);
+            let hi = fmin(self.d[i + h], o.d[i + h]);
+            sep |= lo > hi;
+            depth = fmin(depth, (hi - lo) * Self::inv_len(i));
+        }
+        if sep {
+            -1.0
+        } else {
+            depth
+        }
     }
 
     fn inflated(&self, slack: f32) -> Self {
@@ -384,6 +458,7 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Mat3;
 
     #[test]
     fn axes_are_distinct_and_cover_the_seed_lists() {
@@ -441,5 +516,45 @@ mod tests {
             &crate::geom::Aabb::motion(&Affine3A::IDENTITY, 0.0),
             &crate::geom::Aabb::from_points(&[Vec3::new(0.9, 0.9, 0.9)])
         ));
+    }
+
+    #[test]
+    fn transformed_bounds_the_rotated_box_part() {
+        let pts = [
+            Vec3::new(0.3, -1.0, 2.0),
+            Vec3::new(1.5, 0.2, -0.7),
+            Vec3::new(-0.4, 0.9, 0.1),
+            Vec3::new(0.0, 0.0, 1.0),
+        ];
+        let q = glam::Quat::from_axis_angle(Vec3::new(0.3, -0.8, 0.5).normalize(), 1.1);
+        let pose = Affine3A::from_rotation_translation(q, Vec3::new(4.0, -2.0, 0.5));
+        fn check<const K: usize>(pts: &[Vec3], pose: &Affine3A) {
+            let k = Kdop::<K>::from_points(pts);
+            let t = k.transformed(pose);
+            // Every rotated point (and every rotated corner of the AABB part) inside.
+            let (lo, hi) = (
+                Vec3::new(k.d[0], k.d[1], k.d[2]),
+                Vec3::new(k.d[K / 2], k.d[K / 2 + 1], k.d[K / 2 + 2]),
+            );
+            let corners = (0..8).map(|c| {
+                Vec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), hi, lo)
+            });
+            for p in pts.iter().copied().chain(corners) {
+                assert!(t.inflated(1e-5).contains_point(pose.transform_point3(p)));
+            }
+            // And each slab is the support of the rotated box: `u·(Rc + t) ± |Rᵀu|·e`
+            // with `Rᵀu` as a matrix product.
+            let (c, e) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+            for i in 0..K / 2 {
+                let u = Kdop::<K>::axis(i).unwrap();
+                let m = u.dot(pose.transform_point3(c));
+                let r = (Mat3::from(pose.matrix3).transpose() * u).abs().dot(e);
+                assert!((t.d[i] - (m - r)).abs() < 1e-5, "{K} {i}");
+                assert!((t.d[i + K / 2] - (m + r)).abs() < 1e-5, "{K} {i}");
+            }
+        }
+        check::<14>(&pts, &pose);
+        check::<18>(&pts, &pose);
+        check::<26>(&pts, &pose);
     }
 }

@@ -1,7 +1,7 @@
 //! Top-down binary build [sources: bvh-build].
 
 use super::options::{BuildOptions, SplitRule};
-use super::tree::{coord_bound, Bvh, Node};
+use super::tree::{coord_bound, subtree_sizes, Bvh, Node};
 use crate::geom::Aabb;
 use crate::narrow::bv::BoundingVolume;
 use crate::narrow::TriMesh;
@@ -69,6 +69,7 @@ impl<BV: BoundingVolume> Bvh<BV> {
             .map(|&t| mesh.triangles()[t as usize])
             .collect();
         Bvh {
+            subtree: subtree_sizes(&nodes),
             nodes,
             tris,
             ids: order,

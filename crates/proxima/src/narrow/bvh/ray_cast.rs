@@ -8,40 +8,58 @@ use crate::narrow::ray_triangle::{RayFilter, TriangleHit, WoopRay};
 use crate::Result;
 use glam::{Vec3, Vec3A, Vec4};
 
-/// Relative widening of the box entry and exit parameters: the subtraction, the
-/// rounded reciprocal and the product each round by at most ε/2.
+/// Relative widening of the box entry and exit parameters, folded into the
+/// inverse direction: the subtraction, the rounded reciprocal, the widening
+/// product and the final product each round by at most ε/2, so a factor of
+/// `1 ∓ 4ε` keeps the computed entry at or below, and the exit at or above, the
+/// exact ones (`(1 − 4ε)(1 + ε/2)⁴ < 1 < (1 + 4ε)(1 − ε/2)⁴`).
 const WIDEN: f32 = 4.0 * f32::EPSILON;
 
-/// The ray in the form the 4-wide slab test wants: origin and inverse direction
-/// splatted per axis.
+/// The ray in the form the 4-wide slab test wants, per axis: the origin splatted
+/// and the inverse direction widened down for the entry side and up for the
+/// exit side ([`WIDEN`]).
 struct Slabs {
     o: [Vec4; 3],
-    inv: [Vec4; 3],
+    inv_near: [Vec4; 3],
+    inv_far: [Vec4; 3],
+}
+
+impl Slabs {
+    /// The slabs of a ray from `origin` with finite inverse direction `inv`.
+    #[inline(always)]
+    fn new(origin: Vec3, inv: Vec3) -> Slabs {
+        let lo = inv * (1.0 - WIDEN);
+        let hi = inv * (1.0 + WIDEN);
+        Slabs {
+            o: [0, 1, 2].map(|a| Vec4::splat(origin[a])),
+            inv_near: [0, 1, 2].map(|a| Vec4::splat(lo[a])),
+            inv_far: [0, 1, 2].map(|a| Vec4::splat(hi[a])),
+        }
+    }
 }
 
 /// Entry parameters of the ray into the four lanes of `n` and the mask of lanes it
-/// enters at or before `limit`: slab test with the precomputed inverse direction
-/// (all finite), each slab's near side the min of its two crossings, the interval
-/// widened by [`WIDEN`] so rounding never culls a box the ray touches. Only
-/// vertical SIMD operations.
+/// enters at or before `limit` (widened by [`WIDEN`], so a box entered exactly at
+/// the best hit is kept: a tie may go to a smaller triangle index), for a ray of
+/// octant `OCT` (bit `a` set when the direction is negative on axis `a`): slab
+/// test with the precomputed inverse direction (all finite), the entry side of
+/// each slab (the min corner for a positive direction, else the max) fixed at
+/// compile time, so a node costs two subtractions, two products, a max and a min
+/// per axis, vertical SIMD only (computing both sides and sorting them with a min
+/// and a max costs a third more).
+/// Unused lanes hold the empty box (`+∞` min, `−∞` max): entered at `+∞`, left
+/// at `−∞`, never entered. Rounding never culls a box the ray touches
+/// ([`WIDEN`]).
 #[inline(always)]
-fn entry4(n: &RayNode, s: &Slabs, limit: f32) -> (Vec4, u32) {
+fn entry4<const OCT: usize>(n: &RayNode, s: &Slabs, limit: f32) -> (Vec4, u32) {
     let mut near = Vec4::ZERO;
-    let mut far = Vec4::splat(limit);
+    let mut far = Vec4::splat(limit * (1.0 + WIDEN));
     for a in 0..3 {
-        // Both sides, then min/max: cheaper than selecting the near side per
-        // node, and the same values (rounding is monotonic, so the side nearer
-        // in exact arithmetic stays nearer or equal).
-        let t0 = (n.b[0][a] - s.o[a]) * s.inv[a];
-        let t1 = (n.b[1][a] - s.o[a]) * s.inv[a];
-        near = near.max(t0.min(t1));
-        far = far.min(t0.max(t1));
+        let k = (OCT >> a) & 1;
+        near = near.max((n.b[k][a] - s.o[a]) * s.inv_near[a]);
+        far = far.min((n.b[1 - k][a] - s.o[a]) * s.inv_far[a]);
     }
-    let near = near * (1.0 - WIDEN);
-    // `limit` was in `far` before widening: a box entered exactly at the best
-    // hit is kept (a tie may go to a smaller triangle index).
-    let far = far * (1.0 + WIDEN);
-    (near, near.cmple(far).bitmask() & ((1u32 << n.len) - 1))
+    (near, near.cmple(far).bitmask())
 }
 
 /// [`entry4`] for a ray with a zero or subnormal direction component: the general
@@ -84,24 +102,56 @@ impl RayBvh {
     /// The cast of a validated ray (`any`: stop at the first hit found).
     pub(crate) fn cast_valid(&self, ray: &Ray, any: bool) -> Option<TriangleHit> {
         let inv = Vec3::ONE / ray.dir;
-        let finite = inv.is_finite();
-        if !finite || self.root_link & LEAF != 0 {
-            // (Otherwise the root node's lanes are the first test.)
-            let root = self.root.ray_entry(ray, 0.0)?;
-            if root > ray.max_t {
-                return None;
-            }
+        if !inv.is_finite() || self.root_link & LEAF != 0 {
+            return self.cast_other(ray, any, inv);
         }
-        if finite {
-            let o = ray.origin;
-            let s = Slabs {
-                o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
-                inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
-            };
-            self.traverse(ray, any, |n, limit| entry4(n, &s, limit))
+        // (The root node's lanes are the first test.)
+        self.cast_octant(ray, any, inv)
+    }
+
+    /// [`RayBvh::cast_valid`] of a ray with a zero or subnormal direction
+    /// component, or on a one-leaf tree: clipped to the root box first. Out of
+    /// line, so that the common case needs no stack frame of its own.
+    #[inline(never)]
+    fn cast_other(&self, ray: &Ray, any: bool, inv: Vec3) -> Option<TriangleHit> {
+        let root = self.root.ray_entry(ray, 0.0)?;
+        if root > ray.max_t {
+            return None;
+        }
+        if inv.is_finite() {
+            self.cast_octant(ray, any, inv)
         } else {
             self.traverse(ray, any, |n, limit| entry4_general(n, ray, limit))
         }
+    }
+
+    /// The descent of a ray with finite inverse direction `inv`, by its octant.
+    #[inline(always)]
+    fn cast_octant(&self, ray: &Ray, any: bool, inv: Vec3) -> Option<TriangleHit> {
+        match inv.cmplt(Vec3::ZERO).bitmask() {
+            0 => self.traverse_octant::<0>(ray, any, inv),
+            1 => self.traverse_octant::<1>(ray, any, inv),
+            2 => self.traverse_octant::<2>(ray, any, inv),
+            3 => self.traverse_octant::<3>(ray, any, inv),
+            4 => self.traverse_octant::<4>(ray, any, inv),
+            5 => self.traverse_octant::<5>(ray, any, inv),
+            6 => self.traverse_octant::<6>(ray, any, inv),
+            _ => self.traverse_octant::<7>(ray, any, inv),
+        }
+    }
+
+    /// [`RayBvh::traverse`] of a ray of octant `OCT` with finite inverse
+    /// direction `inv`: one copy of the descent per octant, so each reads its
+    /// slab sides at fixed offsets.
+    #[inline(never)]
+    fn traverse_octant<const OCT: usize>(
+        &self,
+        ray: &Ray,
+        any: bool,
+        inv: Vec3,
+    ) -> Option<TriangleHit> {
+        let s = Slabs::new(ray.origin, inv);
+        self.traverse(ray, any, |n, limit| entry4::<OCT>(n, &s, limit))
     }
 
     /// Front-to-back descent: at each node the four lanes are tested at once, the

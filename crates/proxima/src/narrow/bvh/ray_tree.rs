@@ -19,7 +19,9 @@ pub(crate) const LEAF: u32 = 1 << 31;
 pub(crate) struct RayNode {
     /// `b[0][axis]`: the children's min corners on `axis`; `b[1][axis]`: their
     /// max corners (one array, so a cast picks the near side by index, per ray,
-    /// instead of by a select per node).
+    /// instead of by a select per node). Lanes past `len` hold the empty box
+    /// (`+∞` min, `−∞` max): no ray enters them, so the slab test needs no lane
+    /// mask.
     pub b: [[Vec4; 3]; 2],
     /// Child links: a node index, or `LEAF | leaf index`.
     pub child: [u32; 4],
@@ -29,7 +31,10 @@ pub(crate) struct RayNode {
 
 impl RayNode {
     const EMPTY: RayNode = RayNode {
-        b: [[Vec4::ZERO; 3]; 2],
+        b: [
+            [Vec4::splat(f32::INFINITY); 3],
+            [Vec4::splat(f32::NEG_INFINITY); 3],
+        ],
         child: [0; 4],
         len: 0,
     };
@@ -82,7 +87,8 @@ impl RayTri {
 /// children in SIMD lanes (128 bytes), and the triangles are copied in leaf order
 /// with their corners and normal (64 bytes each) and, four at a time, with the
 /// pre-test's data in SIMD lanes (208 bytes per four), so a cast reads no index
-/// and no vertex array. Casts use a precomputed inverse direction, an ordered
+/// and no vertex array. Casts use a precomputed inverse direction (one copy of
+/// the descent per direction octant, whose slab sides are then fixed), an ordered
 /// front-to-back descent pruned by the best hit, and a conservative `f32`
 /// pre-test of four triangles at once before the exact watertight
 /// [`ray_triangle`](crate::narrow::ray_triangle) on the survivors, nearest

@@ -47,3 +47,33 @@ impl Stack {
         Some((x as u32, f32::from_bits((x >> 32) as u32)))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The stack is a LIFO across spills and refills: random pushes and pops
+    /// against a `Vec`, deep enough to spill several times.
+    #[test]
+    fn lifo_across_spills() {
+        let mut s = Stack::new();
+        let mut v: Vec<(u32, f32)> = Vec::new();
+        let mut x = 12345u32;
+        for step in 0..20_000u32 {
+            x = x.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+            // Phases that grow (up to ~100 deep) and shrink.
+            let grow = (step / 500) % 2 == 0;
+            if (x >> 16) % 4 != 0 && grow || (x >> 16) % 4 == 0 && !grow {
+                let item = (step, step as f32 * 0.5);
+                s.push(item);
+                v.push(item);
+            } else {
+                assert_eq!(s.pop(), v.pop());
+            }
+        }
+        while let Some(item) = v.pop() {
+            assert_eq!(s.pop(), Some(item));
+        }
+        assert_eq!(s.pop(), None);
+    }
+}

@@ -2,6 +2,7 @@
 
 use super::tree::{Bvh, Node};
 use crate::narrow::bv::BoundingVolume;
+use glam::Vec3;
 
 /// Where the moving tree's volumes come from during a traversal, and how they are
 /// tested against the fixed tree's.
@@ -10,6 +11,9 @@ pub(crate) trait VolumeSource<BV> {
     fn overlaps(&mut self, i: usize, other: &BV) -> bool;
     /// The size of node `i` (to pick the tree to descend).
     fn size(&mut self, i: usize) -> f32;
+    /// [`BoundingVolume::overlap_depth`] of node `i` and `other`: negative iff
+    /// [`VolumeSource::overlaps`] is false.
+    fn overlap_depth(&mut self, i: usize, other: &BV) -> f32;
 }
 
 /// The tree's own volumes, moved by a prepared motion inside the test.
@@ -27,6 +31,10 @@ impl<BV: BoundingVolume> VolumeSource<BV> for Local<'_, BV> {
     fn size(&mut self, i: usize) -> f32 {
         self.nodes[i].bv.size()
     }
+    #[inline(always)]
+    fn overlap_depth(&mut self, i: usize, other: &BV) -> f32 {
+        self.nodes[i].bv.overlap_depth(&self.motion, other)
+    }
 }
 
 /// Volumes precomputed per node in the fixed frame, already enlarged by the slack
@@ -42,11 +50,14 @@ impl<BV: BoundingVolume> VolumeSource<BV> for Precomputed<'_, BV> {
     fn size(&mut self, i: usize) -> f32 {
         self.0[i].size()
     }
+    #[inline(always)]
+    fn overlap_depth(&mut self, i: usize, other: &BV) -> f32 {
+        self.0[i].overlap_depth_fixed(other)
+    }
 }
 
 /// Volumes transformed on first use ([`BoundingVolume::transformed`]) and enlarged
-/// by the slack, counting each as one node update. A [`VolumeSource`] as every
-/// source of volumes posed in the fixed frame (`moving.rs`).
+/// by the slack, counting each as one node update.
 pub(crate) struct Lazy<'a, BV> {
     pub nodes: &'a [Node<BV>],
     pub pose: glam::Affine3A,
@@ -67,13 +78,110 @@ impl<BV: BoundingVolume> Lazy<'_, BV> {
     }
 }
 
+impl<BV: BoundingVolume> VolumeSource<BV> for Lazy<'_, BV> {
+    #[inline]
+    fn overlaps(&mut self, i: usize, other: &BV) -> bool {
+        self.get(i).overlaps_fixed(other)
+    }
+    #[inline]
+    fn size(&mut self, i: usize) -> f32 {
+        self.get(i).size()
+    }
+    #[inline]
+    fn overlap_depth(&mut self, i: usize, other: &BV) -> f32 {
+        self.get(i).overlap_depth_fixed(other)
+    }
+}
+
+/// [`Lazy`] with exact volumes near the leaves: a leaf's volume is fitted to its
+/// triangles' posed corners (`pose.transform_point3`, the `f32` points the
+/// triangle tests see), an internal node with a small subtree (at most
+/// `below` triangles: the query's choice) merges its children's, a larger one takes the
+/// conservative [`BoundingVolume::transformed`] bound; all enlarged by the slack
+/// and computed on first use (one node update each).
+///
+/// Collisions are decided near the leaves, where the transformed bound of a
+/// rotated k-DOP is loosest relative to its content (up to `√3` times its
+/// size): exact volumes there cost three vertex transforms per reached leaf and
+/// cut the volume and triangle tests by about half (W5, k-DOP18: as few as the
+/// source's full refit, [sources: bvh-rotate], which updates every node).
+pub(crate) struct ExactLeaves<'a, BV> {
+    pub lazy: Lazy<'a, BV>,
+    /// The moving tree's triangles in leaf order, and its mesh's vertices.
+    pub tris: &'a [[u32; 3]],
+    pub vertices: &'a [Vec3],
+    /// Triangles below each node of the moving tree (`Bvh::subtree`).
+    pub sizes: &'a [u32],
+    /// Subtrees of at most this many triangles get exact volumes.
+    pub below: u32,
+}
+
+impl<BV: BoundingVolume> ExactLeaves<'_, BV> {
+    #[inline]
+    pub(crate) fn get(&mut self, i: usize) -> &BV {
+        if !self.lazy.cache.is_set(i) {
+            let bv = self.exact_or_transformed(i);
+            self.lazy.updates += 1;
+            return self.lazy.cache.put(i, bv);
+        }
+        self.lazy.cache.value(i)
+    }
+
+    /// The moved volume of node `i` (not cached yet; its children may be).
+    fn exact_or_transformed(&mut self, i: usize) -> BV {
+        let nodes = self.lazy.nodes;
+        let n = &nodes[i];
+        if n.is_leaf() {
+            let (pose, tris, verts) = (&self.lazy.pose, self.tris, self.vertices);
+            let corners = |k: usize| tris[k].map(|v| pose.transform_point3(verts[v as usize]));
+            let mut range = n.triangle_range();
+            let mut bv = BV::from_points(&corners(range.start));
+            range.start += 1;
+            for k in range {
+                bv = bv.merge(&BV::from_points(&corners(k)));
+            }
+            return bv.inflated(self.lazy.slack);
+        }
+        if self.sizes[i] > self.below {
+            return n.bv.transformed(&self.lazy.pose).inflated(self.lazy.slack);
+        }
+        // A small subtree: the merge of the children's exact volumes (each
+        // cached, as the descent will likely need them).
+        let (l, r) = n.children(i as u32);
+        let left = *self.get(l as usize);
+        left.merge(self.get(r as usize))
+    }
+}
+
+impl<BV: BoundingVolume> VolumeSource<BV> for ExactLeaves<'_, BV> {
+    #[inline]
+    fn overlaps(&mut self, i: usize, other: &BV) -> bool {
+        self.get(i).overlaps_fixed(other)
+    }
+    #[inline]
+    fn size(&mut self, i: usize) -> f32 {
+        self.get(i).size()
+    }
+    #[inline]
+    fn overlap_depth(&mut self, i: usize, other: &BV) -> f32 {
+        self.get(i).overlap_depth_fixed(other)
+    }
+}
+
 /// Descends both trees from their roots: a pair of nodes whose volumes overlap is
 /// split on the side that is not a leaf, or on the larger volume when neither is
 /// ([sources: bvh-traverse], with the usual "descend the larger" refinement); a pair of
 /// overlapping leaves goes to `leaf(a_node, b_node)`, which returns true to stop.
 /// Each pair of leaves is reached at most once, so each triangle pair is tested at
 /// most once. Counts volume tests in `nv`. Returns true if stopped early.
-pub(crate) fn traverse<BV: BoundingVolume>(
+///
+/// The two child pairs of a split are tested before anything is pushed: only
+/// overlapping pairs go on the stack, and the descent continues with the first
+/// of them without a push and a pop (depth first). With `DEEPEST_FIRST` (the
+/// first-contact query), the child pair whose volumes overlap more deeply
+/// ([`BoundingVolume::overlap_depth`]) comes first, else the left one: the
+/// same pairs are visited either way until the leaf callback stops the descent.
+pub(crate) fn traverse<BV: BoundingVolume, const DEEPEST_FIRST: bool>(
     a: &Bvh<BV>,
     src: &mut impl VolumeSource<BV>,
     b: &Bvh<BV>,
@@ -82,44 +190,77 @@ pub(crate) fn traverse<BV: BoundingVolume>(
     mut leaf: impl FnMut(usize, usize) -> bool,
 ) -> bool {
     stack.clear();
-    stack.push((0, 0));
-    while let Some((ia, ib)) = stack.pop() {
-        let nb = &b.nodes[ib as usize];
-        *nv += 1;
-        if !src.overlaps(ia as usize, &nb.bv) {
-            continue;
-        }
+    *nv += 1;
+    if !src.overlaps(0, &b.nodes[0].bv) {
+        return false;
+    }
+    // The current pair: its volumes overlap.
+    let (mut ia, mut ib) = (0u32, 0u32);
+    loop {
         let na = &a.nodes[ia as usize];
-        match (na.is_leaf(), nb.is_leaf()) {
+        let nb = &b.nodes[ib as usize];
+        let descend_a = match (na.is_leaf(), nb.is_leaf()) {
             (true, true) => {
                 if leaf(ia as usize, ib as usize) {
                     return true;
                 }
-            }
-            (false, true) => push_a(stack, na, ia, ib),
-            (true, false) => push_b(stack, nb, ia, ib),
-            (false, false) => {
-                if src.size(ia as usize) >= nb.bv.size() {
-                    push_a(stack, na, ia, ib)
-                } else {
-                    push_b(stack, nb, ia, ib)
+                match stack.pop() {
+                    Some(next) => {
+                        (ia, ib) = next;
+                        continue;
+                    }
+                    None => return false,
                 }
             }
-        }
+            (false, true) => true,
+            (true, false) => false,
+            (false, false) => src.size(ia as usize) >= nb.bv.size(),
+        };
+        // The two child pairs and whether (how deeply) each overlaps.
+        *nv += 2;
+        let (x, y, dx, dy) = if descend_a {
+            let (l, r) = na.children(ia);
+            let bv = &nb.bv;
+            if DEEPEST_FIRST {
+                let (dl, dr) = (
+                    src.overlap_depth(l as usize, bv),
+                    src.overlap_depth(r as usize, bv),
+                );
+                ((l, ib), (r, ib), dl, dr)
+            } else {
+                let d = |o: bool| if o { 0.0 } else { -1.0 };
+                let (ol, or) = (src.overlaps(l as usize, bv), src.overlaps(r as usize, bv));
+                ((l, ib), (r, ib), d(ol), d(or))
+            }
+        } else {
+            let (l, r) = nb.children(ib);
+            let (bl, br) = (&b.nodes[l as usize].bv, &b.nodes[r as usize].bv);
+            let va = ia as usize;
+            if DEEPEST_FIRST {
+                let (dl, dr) = (src.overlap_depth(va, bl), src.overlap_depth(va, br));
+                ((ia, l), (ia, r), dl, dr)
+            } else {
+                let d = |o: bool| if o { 0.0 } else { -1.0 };
+                let (ol, or) = (src.overlaps(va, bl), src.overlaps(va, br));
+                ((ia, l), (ia, r), d(ol), d(or))
+            }
+        };
+        (ia, ib) = match (dx >= 0.0, dy >= 0.0) {
+            (true, true) => {
+                let (first, second) = if DEEPEST_FIRST && dy > dx {
+                    (y, x)
+                } else {
+                    (x, y)
+                };
+                stack.push(second);
+                first
+            }
+            (true, false) => x,
+            (false, true) => y,
+            (false, false) => match stack.pop() {
+                Some(next) => next,
+                None => return false,
+            },
+        };
     }
-    false
-}
-
-#[inline]
-fn push_a<BV>(stack: &mut Vec<(u32, u32)>, na: &Node<BV>, ia: u32, ib: u32) {
-    let (l, r) = na.children(ia);
-    stack.push((r, ib));
-    stack.push((l, ib));
-}
-
-#[inline]
-fn push_b<BV>(stack: &mut Vec<(u32, u32)>, nb: &Node<BV>, ia: u32, ib: u32) {
-    let (l, r) = nb.children(ib);
-    stack.push((ia, r));
-    stack.push((ia, l));
 }

@@ -59,6 +59,8 @@ pub struct Bvh<BV> {
     pub(crate) tris: Vec<[u32; 3]>,
     /// `ids[k]`: index in the mesh of `tris[k]`.
     pub(crate) ids: Vec<u32>,
+    /// `subtree[i]`: the number of triangles below node `i`.
+    pub(crate) subtree: Vec<u32>,
     /// The mesh (and its vertex version) the volumes were fitted to.
     pub(crate) mesh: MeshStamp,
     /// Max over vertices of `|x| + |y| + |z|` (for the rounding slack).
@@ -125,6 +127,21 @@ impl<BV: BoundingVolume> Bvh<BV> {
             "the mesh's vertices changed since the BVH was built or refit (refit it)".into(),
         ))
     }
+}
+
+/// The number of triangles below each node (one reverse sweep of the pre-order
+/// array: children come after their parent).
+pub(crate) fn subtree_sizes<BV>(nodes: &[Node<BV>]) -> Vec<u32> {
+    let mut n = vec![0u32; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        n[i] = if nodes[i].is_leaf() {
+            nodes[i].count
+        } else {
+            let (l, r) = nodes[i].children(i as u32);
+            n[l as usize] + n[r as usize]
+        };
+    }
+    n
 }
 
 /// Max over `vertices` of `|x| + |y| + |z|`.

@@ -50,6 +50,22 @@ impl<T: Copy> QueryCache<T> {
         self.stamp[k] == self.generation
     }
 
+    /// Sets entry `k` for this query and returns it.
+    #[inline]
+    pub(crate) fn put(&mut self, k: usize, value: T) -> &T {
+        self.stamp[k] = self.generation;
+        self.data[k] = value;
+        &self.data[k]
+    }
+
+    /// Entry `k`, which must be set in this query ([`QueryCache::is_set`]); a
+    /// stale entry otherwise (never undefined: every entry is initialized).
+    #[inline]
+    pub(crate) fn value(&self, k: usize) -> &T {
+        debug_assert!(self.is_set(k));
+        &self.data[k]
+    }
+
     /// The entry at `k`, from `make()` on first use in this query.
     #[inline]
     pub(crate) fn get(&mut self, k: usize, make: impl FnOnce() -> T) -> &T {

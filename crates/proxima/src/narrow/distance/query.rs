@@ -5,7 +5,7 @@
 use super::traverse::{descend, Cut, Frontier, Order, Visit};
 use super::triangle::{contact_witness, disjoint_closest, plane_gap, Tri64};
 use crate::narrow::bv::BoundingVolume;
-use crate::narrow::bvh::moving::{query_slack, AutoUpdate, Descent, LowerBounds, MovingVolumes};
+use crate::narrow::bvh::moving::{query_slack, Descent, LowerBounds, Moved, MovingVolumes};
 use crate::narrow::bvh::pose_deviation;
 use crate::narrow::bvh::tri_cache::QueryCache;
 use crate::narrow::triangles_intersect;
@@ -489,7 +489,16 @@ where
     BV: BoundingVolume,
     V: FnMut(&dyn Fn(u32) -> Vec3, Visit, &mut Cut) -> bool,
 {
-    const AUTO: AutoUpdate = AutoUpdate::ExactLeaves;
+    /// `Auto`: exact volumes for subtrees of at most 8 triangles, where the
+    /// distance queries are decided (see [`Proximity::rotation`]).
+    #[inline(always)]
+    fn moved(rotation: RotationUpdate) -> Moved {
+        match rotation {
+            RotationUpdate::Refit => Moved::Refit,
+            RotationUpdate::Conservative => Moved::Transformed,
+            RotationUpdate::Auto => Moved::Exact { below: 8 },
+        }
+    }
 
     #[inline]
     fn descend(mut self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3) {

@@ -1,0 +1,263 @@
+//! numpy in: every array argument goes through here, so that shapes, dtypes,
+//! non-contiguous views, lists and NaN are handled in one place. Inputs are
+//! copied into Rust vectors while the interpreter is held; the work that follows
+//! may release it without any Python object being read concurrently.
+
+use crate::errors::OrRaise;
+use numpy::{PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use proxima::geom::Ray;
+use proxima::glam::{Affine3A, Mat3A, Mat4, Vec3, Vec3A};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+
+/// How far the last row of a 4×4 pose may be from `(0, 0, 0, 1)`.
+const AFFINE_ROW_TOLERANCE: f32 = 1e-5;
+
+/// `numpy.asarray(obj)` (a no-op for an array), any failure as a `ValueError`
+/// naming the argument.
+fn as_ndarray<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyAny>> {
+    let py = obj.py();
+    if obj.is_instance_of::<numpy::PyUntypedArray>() {
+        return Ok(obj.clone());
+    }
+    asarray(py)?
+        .call1((obj,))
+        .map_err(|e| PyValueError::new_err(format!("{what}: not an array ({e})")))
+}
+
+/// The dtype kind character of an array (`b'f'`, `b'i'`, ...).
+fn kind(array: &Bound<'_, PyAny>) -> PyResult<u8> {
+    let array = array.cast::<numpy::PyUntypedArray>()?;
+    Ok(array.dtype().kind())
+}
+
+/// `numpy.asarray(array, dtype, order="C")`: a C-contiguous copy of a view,
+/// converted to `dtype` (unlike `ascontiguousarray`, a 0-d array stays 0-d).
+fn contiguous<'py>(array: &Bound<'py, PyAny>, dtype: &str) -> PyResult<Bound<'py, PyAny>> {
+    let py = array.py();
+    let f = asarray(py)?;
+    f.call1((array, dtype, "C"))
+}
+
+/// `numpy.asarray`, looked up once.
+fn asarray(py: Python<'_>) -> PyResult<&Bound<'_, PyAny>> {
+    static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    ASARRAY
+        .get_or_try_init(py, || {
+            py.import("numpy")?.getattr("asarray").map(Bound::unbind)
+        })
+        .map(|f| f.bind(py))
+}
+
+/// A numeric array of any real dtype (bool, integers, floats; not complex,
+/// object or strings) as its shape and its values rounded to `f32`, C order.
+pub fn f32_values(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<usize>, Vec<f32>)> {
+    let a = as_ndarray(obj, what)?;
+    if !matches!(kind(&a)?, b'b' | b'i' | b'u' | b'f') {
+        let dtype = a.cast::<numpy::PyUntypedArray>()?.dtype();
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected real numbers, got an array of dtype {dtype}"
+        )));
+    }
+    let a = match a.cast::<PyArrayDyn<f32>>() {
+        Ok(x) if x.is_c_contiguous() => x.clone(),
+        _ => contiguous(&a, "float32")?.cast_into::<PyArrayDyn<f32>>()?,
+    };
+    let shape = a.shape().to_vec();
+    let values = a
+        .to_vec()
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    Ok((shape, values))
+}
+
+/// An integer array (any integer dtype) as its shape and `i64` values. Floats
+/// are refused (a float index is a mistake, not a conversion).
+pub fn i64_values(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<usize>, Vec<i64>)> {
+    let a = as_ndarray(obj, what)?;
+    match kind(&a)? {
+        b'i' => {}
+        b'u' => {
+            // uint64 values above i64::MAX would wrap: refuse them here.
+            let (shape, v) = u64_values(&a, what)?;
+            let v = v
+                .into_iter()
+                .map(|x| i64::try_from(x).map_err(|_| too_large(what, x)))
+                .collect::<PyResult<_>>()?;
+            return Ok((shape, v));
+        }
+        _ => {
+            let dtype = a.cast::<numpy::PyUntypedArray>()?.dtype();
+            return Err(PyValueError::new_err(format!(
+                "{what}: expected integers, got an array of dtype {dtype}"
+            )));
+        }
+    }
+    let a = match a.cast::<PyArrayDyn<i64>>() {
+        Ok(x) if x.is_c_contiguous() => x.clone(),
+        _ => contiguous(&a, "int64")?.cast_into::<PyArrayDyn<i64>>()?,
+    };
+    let shape = a.shape().to_vec();
+    let values = a
+        .to_vec()
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    Ok((shape, values))
+}
+
+fn u64_values(a: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<usize>, Vec<u64>)> {
+    let a = contiguous(a, "uint64")?.cast_into::<PyArrayDyn<u64>>()?;
+    let shape = a.shape().to_vec();
+    let values = a
+        .to_vec()
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    Ok((shape, values))
+}
+
+fn too_large(what: &str, x: u64) -> PyErr {
+    PyValueError::new_err(format!("{what}: value {x} is too large"))
+}
+
+/// Rows of `cols` numbers: an `(n, cols)` array, or one row as a `(cols,)`
+/// array (`n = 1`); a 1-D array of size 0 is zero rows. Returns the values row
+/// by row and `n`.
+pub fn rows(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<(Vec<f32>, usize)> {
+    let (shape, v) = f32_values(obj, what)?;
+    match shape[..] {
+        [n, c] if c == cols => Ok((v, n)),
+        [c] if c == cols => Ok((v, 1)),
+        [0] => Ok((v, 0)),
+        _ => Err(shape_error(what, &format!("(N, {cols})"), &shape)),
+    }
+}
+
+/// [`rows`], refusing NaN and ±∞ (naming the row).
+pub fn finite_rows(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<(Vec<f32>, usize)> {
+    let (v, n) = rows(obj, cols, what)?;
+    check_finite(&v, cols, what, "row")?;
+    Ok((v, n))
+}
+
+/// Fails on the first non-finite value, naming its item (`unit` `i`: the
+/// `i`-th group of `size` values, a row, a matrix, a pose).
+pub fn check_finite(v: &[f32], size: usize, what: &str, unit: &str) -> PyResult<()> {
+    match v.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(PyValueError::new_err(format!(
+            "{what}: {unit} {} has a non-finite value ({})",
+            i / size.max(1),
+            v[i]
+        ))),
+    }
+}
+
+/// `n` values: a `(n,)` array, or a scalar repeated `n` times.
+pub fn per_row(obj: &Bound<'_, PyAny>, n: usize, what: &str) -> PyResult<Vec<f32>> {
+    let (shape, v) = f32_values(obj, what)?;
+    match shape[..] {
+        [] => Ok(vec![v[0]; n]),
+        [m] if m == n => Ok(v),
+        _ => Err(shape_error(what, &format!("a scalar or ({n},)"), &shape)),
+    }
+}
+
+/// A 1-D integer array (or one integer) as `i64`s.
+pub fn int_list(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<i64>> {
+    let (shape, v) = i64_values(obj, what)?;
+    match shape[..] {
+        [] | [_] => Ok(v),
+        _ => Err(shape_error(what, "(N,)", &shape)),
+    }
+}
+
+/// The `ValueError` for an array of the wrong shape.
+pub fn shape_error(what: &str, want: &str, got: &[usize]) -> PyErr {
+    let got: Vec<String> = got.iter().map(|d| d.to_string()).collect();
+    let got = match got.len() {
+        1 => format!("({},)", got[0]),
+        _ => format!("({})", got.join(", ")),
+    };
+    PyValueError::new_err(format!("{what}: expected shape {want}, got {got}"))
+}
+
+/// The first three values as a vector.
+pub fn vec3(v: &[f32]) -> Vec3 {
+    Vec3::new(v[0], v[1], v[2])
+}
+
+/// 4×4 matrices, row-major as numpy writes them (`m[i, j]` is row `i`, column
+/// `j`): an `(M, 4, 4)` array or one `(4, 4)`. Returns them and whether one
+/// matrix was given.
+pub fn matrices4(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<Mat4>, bool)> {
+    let (shape, v) = f32_values(obj, what)?;
+    let single = match shape[..] {
+        [4, 4] => true,
+        [_, 4, 4] => false,
+        _ => return Err(shape_error(what, "(M, 4, 4) or (4, 4)", &shape)),
+    };
+    check_finite(&v, 16, what, "matrix")?;
+    let m = v
+        .chunks_exact(16)
+        .map(|r| Mat4::from_cols_slice(r).transpose())
+        .collect();
+    Ok((m, single))
+}
+
+/// Rigid poses: `(N, 4, 4)` or `(N, 3, 4)` row-major `[R | t]` matrices, or a
+/// single `(4, 4)` / `(3, 3 + 1)`. The last row of a 4×4 must be `(0, 0, 0, 1)`.
+/// Finite values are checked here; rigidity is checked by the library (its
+/// `check_pose`). Returns the poses and whether one pose was given.
+pub fn poses(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<Affine3A>, bool)> {
+    let (shape, v) = f32_values(obj, what)?;
+    let (rows, single) = match shape[..] {
+        [r @ (3 | 4), 4] => (r, true),
+        [_, r @ (3 | 4), 4] => (r, false),
+        _ => {
+            return Err(shape_error(
+                what,
+                "(N, 4, 4), (N, 3, 4), (4, 4) or (3, 4)",
+                &shape,
+            ))
+        }
+    };
+    let size = rows * 4;
+    check_finite(&v, size, what, "pose")?;
+    v.chunks_exact(size)
+        .enumerate()
+        .map(|(i, m)| {
+            if rows == 4 {
+                let last = [m[12], m[13], m[14], m[15] - 1.0];
+                if last.iter().any(|x| x.abs() > AFFINE_ROW_TOLERANCE) {
+                    return Err(PyValueError::new_err(format!(
+                        "{what}: pose {i}: the last row is {:?}, not (0, 0, 0, 1)",
+                        &m[12..16]
+                    )));
+                }
+            }
+            let r = Mat3A::from_cols(
+                Vec3A::new(m[0], m[4], m[8]),
+                Vec3A::new(m[1], m[5], m[9]),
+                Vec3A::new(m[2], m[6], m[10]),
+            );
+            Ok(Affine3A {
+                matrix3: r,
+                translation: Vec3A::new(m[3], m[7], m[11]),
+            })
+        })
+        .collect::<PyResult<Vec<_>>>()
+        .map(|p| (p, single))
+}
+
+/// Rays from `(m, 6)` rows (origin, direction) and `tmax` (a scalar or `(m,)`).
+pub fn rays(rays: &Bound<'_, PyAny>, tmax: &Bound<'_, PyAny>) -> PyResult<Vec<Ray>> {
+    let (v, m) = finite_rows(rays, 6, "rays")?;
+    let t = per_row(tmax, m, "tmax")?;
+    let out: Vec<Ray> = v
+        .chunks_exact(6)
+        .zip(t)
+        .map(|(r, t)| Ray::with_max_t(vec3(&r[..3]), vec3(&r[3..]), t))
+        .collect();
+    for (i, r) in out.iter().enumerate() {
+        r.validate().or_raise_at(|| format!("rays: row {i}"))?;
+    }
+    Ok(out)
+}

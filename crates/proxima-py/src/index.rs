@@ -1,0 +1,519 @@
+//! `proxima.Index`: any of the six broad-phase indices, chosen by name, over
+//! bounding spheres named by integer ids.
+
+use crate::arrays::{self, finite_rows, int_list, per_row, rows, vec3};
+use crate::errors::OrRaise;
+use crate::queries::{self, Csr};
+use crate::workers::Workers;
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use proxima::broad::{AnyIndex, IndexKind, Query, SceneHint, SpatialIndex};
+use proxima::geom::{Aabb, Frustum, Sphere};
+use proxima::glam::{Mat4, Vec4};
+use proxima::Handle;
+use pyo3::exceptions::{PyKeyError, PyValueError};
+use pyo3::prelude::*;
+
+/// A broad-phase index over bounding spheres: one of the six built-in indices,
+/// chosen by name.
+///
+/// Objects are named by integer **ids**: row `i` of the arrays the index was
+/// built from is id `i`, and each later insert takes the next unused id, so ids
+/// are insertion order (as row numbers are for scipy's cKDTree and geometry ids
+/// for Open3D). An id is never reused: after `remove` or `clear` it raises
+/// `KeyError`. Every query returns ids, so `centers[ids]` selects from the
+/// arrays the index was built from.
+///
+/// Numbers are stored as float32 (float64 input is rounded); overlap is closed
+/// (touching counts) and exact for the stored values.
+#[pyclass(module = "proxima", name = "Index")]
+pub struct Index {
+    inner: AnyIndex<u64>,
+    /// The handle of each id ever issued; `None` once removed. Ids are dense,
+    /// so this is a vector, 16 bytes per id.
+    handles: Vec<Option<Handle>>,
+    // issue #14: per-object collision filters (`Filter` group/mask bits) will be
+    // stored with the objects once the indices take them (insert(..., group=,
+    // mask=) and a `filter=` on every query and on pairs()).
+}
+
+/// `(centers (K, 3), radii (K,))`.
+type Spheres<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f32>>);
+
+/// `(ids (M,), t (M,))` of first ray hits.
+type FirstHits<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f32>>);
+
+/// Spheres from `(n, 3)` centres and `(n,)` (or scalar) radii, each checked
+/// (finite centre, finite non-negative radius), naming the first bad row.
+fn spheres(
+    centers: &Bound<'_, PyAny>,
+    radii: &Bound<'_, PyAny>,
+    what: &str,
+) -> PyResult<Vec<Sphere>> {
+    let (c, n) = finite_rows(centers, 3, "centers")?;
+    let r = per_row(radii, n, "radii")?;
+    let out: Vec<Sphere> = c
+        .chunks_exact(3)
+        .zip(r)
+        .map(|(c, r)| Sphere::new(vec3(c), r))
+        .collect();
+    for (i, s) in out.iter().enumerate() {
+        s.validate().or_raise_at(|| format!("{what}: row {i}"))?;
+    }
+    Ok(out)
+}
+
+/// A world box from `(2, 3)` (`[min, max]`) or `(6,)` numbers.
+fn world_box(obj: &Bound<'_, PyAny>) -> PyResult<Aabb> {
+    let (shape, v) = arrays::f32_values(obj, "world")?;
+    if !matches!(shape[..], [2, 3] | [6]) {
+        return Err(arrays::shape_error("world", "(2, 3) or (6,)", &shape));
+    }
+    arrays::check_finite(&v, 6, "world", "box")?;
+    let b = Aabb::new(vec3(&v[..3]), vec3(&v[3..]));
+    b.validate().or_raise_at(|| "world".into())?;
+    Ok(b)
+}
+
+impl Index {
+    /// The handle of a live id; `KeyError` otherwise.
+    fn handle(&self, id: i64) -> PyResult<Handle> {
+        usize::try_from(id)
+            .ok()
+            .and_then(|i| self.handles.get(i).copied().flatten())
+            .ok_or_else(|| PyKeyError::new_err(format!("id {id} is not in the index")))
+    }
+
+    /// Stores `spheres` (already checked) under the next ids.
+    fn insert_all(&mut self, py: Python<'_>, spheres: Vec<Sphere>) -> PyResult<Vec<i64>> {
+        let first = self.handles.len();
+        let Index { inner, handles } = self;
+        py.detach(|| {
+            handles.reserve(spheres.len());
+            for (k, s) in spheres.into_iter().enumerate() {
+                let id = (first + k) as u64;
+                match inner.insert(s, id) {
+                    Ok(h) => handles.push(Some(h)),
+                    Err(e) => {
+                        // Only a full index fails here: undo this batch.
+                        for h in handles.drain(first..).flatten() {
+                            let _ = inner.remove(h);
+                        }
+                        return Err(e);
+                    }
+                }
+            }
+            Ok(())
+        })
+        .or_raise()?;
+        Ok((first as i64..self.handles.len() as i64).collect())
+    }
+
+    /// A batch query's answer as `(ids, offsets)`, with `t` if asked.
+    fn csr<'py>(py: Python<'py>, out: Csr, with_t: bool) -> Bound<'py, pyo3::types::PyTuple> {
+        let ids = PyArray1::from_vec(py, out.ids).into_any();
+        let offsets = PyArray1::from_vec(py, out.offsets).into_any();
+        let items = if with_t {
+            vec![ids, offsets, PyArray1::from_vec(py, out.t).into_any()]
+        } else {
+            vec![ids, offsets]
+        };
+        pyo3::types::PyTuple::new(py, items).expect("a tuple of arrays")
+    }
+
+    /// Runs a validated batch of queries with the interpreter released.
+    fn run(&self, py: Python<'_>, queries: &[Query], workers: i64) -> PyResult<Csr> {
+        let workers = Workers::new(workers)?;
+        let inner = &self.inner;
+        Ok(py.detach(|| queries::select(inner, queries, &workers)))
+    }
+}
+
+#[pymethods]
+impl Index {
+    /// Index(centers=None, radii=None, *, kind="grid3d", world=None, r_max=None)
+    ///
+    /// Builds an index of `kind` ("brute", "loose-kd", "octree", "grid2d",
+    /// "hashgrid" or "grid3d") holding the spheres `centers` (N, 3) with
+    /// `radii` (N,) or one radius for all; row i gets id i. The index is tuned
+    /// from the spheres (their box and the 99th percentile of the radii)
+    /// unless `world` ([min, max] as (2, 3) or (6,)) and `r_max` (a typical
+    /// large radius) say otherwise: give both when building an empty index
+    /// that is filled by `insert` later. Any sphere is accepted, inside the
+    /// world or not; the hint only tunes speed. Cost: O(N) plus the inserts.
+    ///
+    /// Raises ValueError on an unknown kind, a wrong shape, a non-finite value
+    /// or a negative radius.
+    #[new]
+    #[pyo3(signature = (centers=None, radii=None, *, kind="grid3d", world=None, r_max=None))]
+    fn new(
+        py: Python<'_>,
+        centers: Option<&Bound<'_, PyAny>>,
+        radii: Option<&Bound<'_, PyAny>>,
+        kind: &str,
+        world: Option<&Bound<'_, PyAny>>,
+        r_max: Option<f32>,
+    ) -> PyResult<Index> {
+        let kind: IndexKind = kind.parse().or_raise()?;
+        let spheres = match (centers, radii) {
+            (Some(c), Some(r)) => spheres(c, r, "spheres")?,
+            (None, None) => Vec::new(),
+            _ => {
+                return Err(PyValueError::new_err(
+                    "give both centers and radii, or neither",
+                ))
+            }
+        };
+        let mut hint = SceneHint::from_spheres(spheres.iter().copied(), spheres.len());
+        if let Some(w) = world {
+            hint.world = world_box(w)?;
+        }
+        if let Some(r) = r_max {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(PyValueError::new_err(format!(
+                    "r_max must be finite and positive, got {r}"
+                )));
+            }
+            hint.r_max = r;
+            hint.r_largest = hint.r_largest.max(r);
+        }
+        let mut index = Index {
+            inner: kind.build(&hint).or_raise()?,
+            handles: Vec::new(),
+        };
+        index.insert_all(py, spheres)?;
+        Ok(index)
+    }
+
+    /// The index's kind, as its name ("grid3d", ...).
+    #[getter]
+    fn kind(&self) -> &'static str {
+        self.inner.kind().name()
+    }
+
+    /// Number of stored objects.
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// Whether `id` names a stored object.
+    fn __contains__(&self, id: &Bound<'_, PyAny>) -> bool {
+        id.extract::<i64>().is_ok_and(|id| self.handle(id).is_ok())
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Index(kind={:?}, len={})", self.kind(), self.inner.len())
+    }
+
+    /// Stores one sphere and returns its id. O(log n) typical.
+    fn insert(
+        &mut self,
+        py: Python<'_>,
+        center: &Bound<'_, PyAny>,
+        radius: &Bound<'_, PyAny>,
+    ) -> PyResult<i64> {
+        let s = spheres(center, radius, "sphere")?;
+        if s.len() != 1 {
+            return Err(PyValueError::new_err(
+                "insert takes one sphere; use insert_many",
+            ));
+        }
+        Ok(self.insert_all(py, s)?[0])
+    }
+
+    /// Stores the spheres `centers` (K, 3) with `radii` (K,) or one radius,
+    /// and returns their ids (K,), consecutive. All or nothing: a bad row
+    /// raises ValueError naming it and stores nothing.
+    fn insert_many<'py>(
+        &mut self,
+        py: Python<'py>,
+        centers: &Bound<'py, PyAny>,
+        radii: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let s = spheres(centers, radii, "spheres")?;
+        Ok(PyArray1::from_vec(py, self.insert_all(py, s)?))
+    }
+
+    /// Removes an object. KeyError if `id` is not stored.
+    fn remove(&mut self, id: i64) -> PyResult<()> {
+        let h = self.handle(id)?;
+        self.inner.remove(h).or_raise()?;
+        self.handles[id as usize] = None;
+        Ok(())
+    }
+
+    /// Removes every object of `ids`. All or nothing: KeyError, removing
+    /// nothing, if one is not stored or appears twice.
+    fn remove_many(&mut self, ids: &Bound<'_, PyAny>) -> PyResult<()> {
+        let ids = int_list(ids, "ids")?;
+        let mut hs = Vec::with_capacity(ids.len());
+        for &id in &ids {
+            hs.push((id, self.handle(id)?));
+        }
+        let mut sorted: Vec<i64> = ids.clone();
+        sorted.sort_unstable();
+        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+            return Err(PyKeyError::new_err(format!("id {} appears twice", w[0])));
+        }
+        for (id, h) in hs {
+            self.inner.remove(h).or_raise()?;
+            self.handles[id as usize] = None;
+        }
+        Ok(())
+    }
+
+    /// Moves (and with `radius`, resizes) one object. KeyError if `id` is not
+    /// stored; ValueError on a bad sphere (nothing changes).
+    #[pyo3(signature = (id, center, radius=None))]
+    fn update(
+        &mut self,
+        py: Python<'_>,
+        id: i64,
+        center: &Bound<'_, PyAny>,
+        radius: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let ids = pyo3::types::PyList::new(py, [id])?;
+        self.update_many(py, Some(ids.as_any()), center, radius)
+    }
+
+    /// Moves the objects `ids` (K,) to `centers` (K, 3), and resizes them to
+    /// `radii` (K,) or one radius if given (otherwise they keep theirs).
+    /// `ids=None` means ids 0..K-1 (every object of an index built from K
+    /// rows). All or nothing: a stale id (KeyError) or a bad row (ValueError)
+    /// changes nothing. Runs with the interpreter released. O(K) typical.
+    #[pyo3(signature = (ids, centers, radii=None))]
+    fn update_many(
+        &mut self,
+        py: Python<'_>,
+        ids: Option<&Bound<'_, PyAny>>,
+        centers: &Bound<'_, PyAny>,
+        radii: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let (c, n) = finite_rows(centers, 3, "centers")?;
+        let ids = match ids {
+            Some(ids) => int_list(ids, "ids")?,
+            None => (0..n as i64).collect(),
+        };
+        if ids.len() != n {
+            return Err(PyValueError::new_err(format!(
+                "{} ids but {n} centers",
+                ids.len()
+            )));
+        }
+        let r = radii.map(|r| per_row(r, n, "radii")).transpose()?;
+        let mut moves = Vec::with_capacity(n);
+        for (i, (&id, c)) in ids.iter().zip(c.chunks_exact(3)).enumerate() {
+            let h = self.handle(id)?;
+            let radius = match &r {
+                Some(r) => r[i],
+                None => self.inner.get(h).or_raise()?.0.radius,
+            };
+            let s = Sphere::new(vec3(c), radius);
+            s.validate().or_raise_at(|| format!("spheres: row {i}"))?;
+            moves.push((h, s));
+        }
+        let inner = &mut self.inner;
+        // Every handle is live and every sphere valid: no update can fail.
+        py.detach(|| inner.update_many(moves)).or_raise()
+    }
+
+    /// The centre (3,) and radius of one object. KeyError if not stored.
+    fn get<'py>(&self, py: Python<'py>, id: i64) -> PyResult<(Bound<'py, PyArray1<f32>>, f32)> {
+        let (s, _) = self.inner.get(self.handle(id)?).or_raise()?;
+        Ok((PyArray1::from_slice(py, &s.center.to_array()), s.radius))
+    }
+
+    /// The ids of the stored objects, ascending.
+    fn ids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let ids: Vec<i64> = (self.handles.iter().enumerate())
+            .filter(|(_, h)| h.is_some())
+            .map(|(i, _)| i as i64)
+            .collect();
+        PyArray1::from_vec(py, ids)
+    }
+
+    /// The spheres of `ids` (default: every stored object, by ascending id) as
+    /// `(centers (K, 3), radii (K,))`, float32. KeyError on an id not stored.
+    #[pyo3(signature = (ids=None))]
+    fn spheres<'py>(
+        &self,
+        py: Python<'py>,
+        ids: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Spheres<'py>> {
+        let ids: Vec<i64> = match ids {
+            Some(ids) => int_list(ids, "ids")?,
+            None => self.ids(py).to_vec()?,
+        };
+        let mut c = Vec::with_capacity(ids.len() * 3);
+        let mut r = Vec::with_capacity(ids.len());
+        for id in ids {
+            let (s, _) = self.inner.get(self.handle(id)?).or_raise()?;
+            c.extend(s.center.to_array());
+            r.push(s.radius);
+        }
+        let n = r.len();
+        let c = PyArray1::from_vec(py, c).reshape([n, 3])?;
+        Ok((c, PyArray1::from_vec(py, r)))
+    }
+
+    /// Removes every object (their ids raise KeyError from now on; new inserts
+    /// continue after the last id issued) and releases the memory.
+    fn clear(&mut self) {
+        self.inner.clear();
+        self.handles.iter_mut().for_each(|h| *h = None);
+    }
+
+    /// Bytes held by the index and its id table.
+    #[getter]
+    fn memory_bytes(&self) -> usize {
+        self.inner.memory_bytes() + self.handles.capacity() * std::mem::size_of::<Option<Handle>>()
+    }
+
+    /// Checks the structure's invariants (RuntimeError if one fails: a bug).
+    fn validate(&self) -> PyResult<()> {
+        self.inner.validate().or_raise()
+    }
+
+    /// Objects overlapping each sphere of `spheres` (M, 4) — centre x, y, z,
+    /// radius — (also the point-radius query). Returns `(ids, offsets)`:
+    /// sphere i selects `ids[offsets[i]:offsets[i+1]]`, ascending; int64.
+    /// One (4,) row is a batch of one. `workers`: 1 (this thread), n (a pool
+    /// of n threads) or -1 (one per core). Runs with the interpreter released.
+    #[pyo3(signature = (spheres, *, workers=1))]
+    fn query_spheres<'py>(
+        &self,
+        py: Python<'py>,
+        spheres: &Bound<'py, PyAny>,
+        workers: i64,
+    ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        let (v, _) = rows(spheres, 4, "spheres")?;
+        let qs: Vec<Query> = v
+            .chunks_exact(4)
+            .map(|s| Sphere::new(vec3(s), s[3]).into())
+            .collect();
+        queries::validate(&qs, "spheres")?;
+        Ok(Self::csr(py, self.run(py, &qs, workers)?, false))
+    }
+
+    /// Objects overlapping each box of `boxes` (M, 6) — min x, y, z, max x,
+    /// y, z. Returns `(ids, offsets)` as `query_spheres` does.
+    #[pyo3(signature = (boxes, *, workers=1))]
+    fn query_boxes<'py>(
+        &self,
+        py: Python<'py>,
+        boxes: &Bound<'py, PyAny>,
+        workers: i64,
+    ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        let (v, _) = rows(boxes, 6, "boxes")?;
+        let qs: Vec<Query> = v
+            .chunks_exact(6)
+            .map(|b| Aabb::new(vec3(&b[..3]), vec3(&b[3..])).into())
+            .collect();
+        queries::validate(&qs, "boxes")?;
+        Ok(Self::csr(py, self.run(py, &qs, workers)?, false))
+    }
+
+    /// Objects each ray touches for some t in [0, tmax]: `rays` (M, 6) —
+    /// origin x, y, z, direction x, y, z (any non-zero length; t is in its
+    /// units) — and `tmax` (a scalar or (M,); inf by default). Returns
+    /// `(ids, offsets)`, each ray's hits in order along it (entry t, 0 if the
+    /// origin is inside; ties by id), and with `return_t=True` also `t`
+    /// (float32) beside `ids`.
+    #[pyo3(signature = (rays, tmax=None, *, return_t=false, workers=1))]
+    fn query_rays<'py>(
+        &self,
+        py: Python<'py>,
+        rays: &Bound<'py, PyAny>,
+        tmax: Option<&Bound<'py, PyAny>>,
+        return_t: bool,
+        workers: i64,
+    ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
+        let rs = arrays::rays(rays, tmax.unwrap_or(&inf))?;
+        let qs: Vec<Query> = rs.into_iter().map(Query::from).collect();
+        Ok(Self::csr(py, self.run(py, &qs, workers)?, return_t))
+    }
+
+    /// The first object each ray enters (smallest entry t; between equal t,
+    /// one of them): `rays` (M, 6) and `tmax` as in `query_rays`. Returns
+    /// `(ids (M,) int64, t (M,) float32)`, id -1 and t inf for a miss.
+    #[pyo3(signature = (rays, tmax=None, *, workers=1))]
+    fn ray_first<'py>(
+        &self,
+        py: Python<'py>,
+        rays: &Bound<'py, PyAny>,
+        tmax: Option<&Bound<'py, PyAny>>,
+        workers: i64,
+    ) -> PyResult<FirstHits<'py>> {
+        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
+        let rs = arrays::rays(rays, tmax.unwrap_or(&inf))?;
+        let workers = Workers::new(workers)?;
+        let inner = &self.inner;
+        let (ids, t) = py.detach(|| queries::first_hits(inner, &rs, &workers));
+        Ok((PyArray1::from_vec(py, ids), PyArray1::from_vec(py, t)))
+    }
+
+    /// Objects inside each view frustum (culling): `matrices` (M, 4, 4)
+    /// view-projection matrices (projection @ view, row-major as numpy
+    /// writes them, acting on column vectors (x, y, z, 1)). `depth` is the
+    /// clip-space depth range of the projection: "zero_to_one" (Direct3D,
+    /// Vulkan, Metal, wgpu, glam) or "minus_one_to_one" (OpenGL). A sphere is
+    /// culled only when it lies entirely outside one of the six planes, so
+    /// spheres near a corner may be kept. Returns `(ids, offsets)` as
+    /// `query_spheres` does.
+    #[pyo3(signature = (matrices, *, depth="zero_to_one", workers=1))]
+    fn query_frusta<'py>(
+        &self,
+        py: Python<'py>,
+        matrices: &Bound<'py, PyAny>,
+        depth: &str,
+        workers: i64,
+    ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        // OpenGL's -w <= z <= w becomes 0 <= z' <= w with z' = (z + w) / 2.
+        let to_zero_one = match depth {
+            "zero_to_one" => Mat4::IDENTITY,
+            "minus_one_to_one" => Mat4::from_cols(
+                Vec4::X,
+                Vec4::Y,
+                Vec4::new(0.0, 0.0, 0.5, 0.0),
+                Vec4::new(0.0, 0.0, 0.5, 1.0),
+            ),
+            d => {
+                return Err(PyValueError::new_err(format!(
+                    "depth must be \"zero_to_one\" or \"minus_one_to_one\", got {d:?}"
+                )))
+            }
+        };
+        let (ms, _) = arrays::matrices4(matrices, "matrices")?;
+        let mut qs = Vec::with_capacity(ms.len());
+        for (i, m) in ms.into_iter().enumerate() {
+            let f = Frustum::from_view_projection(to_zero_one * m)
+                .or_raise_at(|| format!("matrices: matrix {i}"))?;
+            qs.push(Query::from(f));
+        }
+        queries::validate(&qs, "matrices")?;
+        Ok(Self::csr(py, self.run(py, &qs, workers)?, false))
+    }
+
+    /// Every pair of stored objects that overlap (touching counts), once, as
+    /// a (P, 2) int64 array of ids with the smaller id first; rows sorted
+    /// unless `sort=False` (then in no particular order, and cheaper).
+    #[pyo3(signature = (*, sort=true, workers=1))]
+    fn pairs<'py>(
+        &self,
+        py: Python<'py>,
+        sort: bool,
+        workers: i64,
+    ) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let workers = Workers::new(workers)?;
+        let inner = &self.inner;
+        let p = py.detach(|| queries::pairs(inner, &workers, sort));
+        let n = p.len();
+        let flat: Vec<i64> = p.into_iter().flatten().collect();
+        PyArray1::from_vec(py, flat).reshape([n, 2])
+    }
+
+    // issue #14: nearest(points, k, *, max_distance=inf, workers=1) ->
+    // (distances (M, k), ids (M, k)) like cKDTree.query (missing neighbours as
+    // inf / -1), and sweep(spheres_from, spheres_to, radius) for sphere casts,
+    // over the indices' k-nearest and sweep queries once they land.
+}

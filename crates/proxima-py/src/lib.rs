@@ -1,0 +1,51 @@
+//! Proxima for Python: the extension module `proxima._native`, re-exported by
+//! the `proxima` package (`python/proxima/__init__.py`) [sources: python].
+//!
+//! - [`index::Index`]: any of the six broad-phase indices by name, over spheres
+//!   given as numpy arrays and named by integer ids; batch queries returning
+//!   CSR `(ids, offsets)`; `pairs()` as an `(P, 2)` array.
+//! - [`mesh::Mesh`]: a triangle mesh with its collision and ray BVHs, from
+//!   arrays or a file; batch ray casts with Open3D's result names.
+//! - [`collide::collide`]: mesh–mesh collision for one pose or a batch, with the
+//!   cost counters ([`collide::Contacts`]).
+//!
+//! Every array argument is converted in [`arrays`] (any real dtype, lists,
+//! non-contiguous views; wrong shapes and NaN raise `ValueError`); library
+//! errors become Python exceptions in [`errors`]; long work runs with the
+//! interpreter released, on the calling thread or on a rayon pool of
+//! `workers` threads ([`workers`]).
+//!
+//! Still to come, each with a marked place: k nearest neighbours, sphere
+//! sweeps and collision filters on `Index` (issue #14, in `index.rs`); the
+//! collision world `World` (issue #13, registered below); mesh distance
+//! queries (issue #15, in `collide.rs`).
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod arrays;
+pub mod collide;
+pub mod errors;
+pub mod index;
+pub mod mesh;
+pub mod queries;
+pub mod workers;
+
+use pyo3::prelude::*;
+
+/// The module `proxima._native`.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<index::Index>()?;
+    m.add_class::<mesh::Mesh>()?;
+    m.add_class::<collide::Contacts>()?;
+    m.add_function(wrap_pyfunction!(collide::collide, m)?)?;
+    m.add(
+        "INDEX_KINDS",
+        proxima::broad::IndexKind::ALL.map(|k| k.name()).to_vec(),
+    )?;
+    m.add("BOUNDING_VOLUMES", mesh::BV_NAMES.to_vec())?;
+    // issue #13: the collision world (`World(index=...)`, add, set_poses,
+    // ignore, contacts, ray_cast) is registered here once `proxima::world`
+    // lands.
+    Ok(())
+}

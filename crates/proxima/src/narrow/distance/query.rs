@@ -274,12 +274,26 @@ impl<BV: BoundingVolume> Proximity<BV> {
         pose: &Affine3A,
         b: &Mesh<BV>,
     ) -> Result<MeshDistance> {
+        self.distance_checked(a, pose, pose_deviation(pose)?, b)
+    }
+
+    /// [`Proximity::distance`] with a pose whose matrix deviates from a
+    /// rotation by `dev` (the largest entry of `|RᵀR - I|`, with no limit: the
+    /// collision world composes two checked poses).
+    pub(crate) fn distance_checked(
+        &mut self,
+        a: &Mesh<BV>,
+        pose: &Affine3A,
+        dev: f32,
+        b: &Mesh<BV>,
+    ) -> Result<MeshDistance> {
         let mut best = None;
         let cut = Cut {
             value: f64::INFINITY,
             inclusive: false,
         };
-        let counters = self.run(a, pose, b, Order::BestFirst, cut, Goal::Nearest(&mut best))?;
+        let goal = Goal::Nearest(&mut best);
+        let counters = self.run(a, pose, dev, b, Order::BestFirst, cut, goal)?;
         // Every mesh has a triangle, so some pair was measured.
         let (d, p, q, i, j) = best.ok_or_else(|| Error::Invalid("no triangle pair".into()))?;
         Ok(MeshDistance {
@@ -311,7 +325,8 @@ impl<BV: BoundingVolume> Proximity<BV> {
             value: margin,
             inclusive: true,
         };
-        self.run(a, pose, b, Order::DepthFirst, cut, Goal::Any(&mut hit))?;
+        let dev = pose_deviation(pose)?;
+        self.run(a, pose, dev, b, Order::DepthFirst, cut, Goal::Any(&mut hit))?;
         Ok(hit)
     }
 
@@ -332,26 +347,43 @@ impl<BV: BoundingVolume> Proximity<BV> {
         b: &Mesh<BV>,
         margin: f64,
     ) -> Result<NearPairs> {
+        // The margin first, as `within`.
+        check_margin(margin, "margin")?;
+        self.pairs_within_checked(a, pose, pose_deviation(pose)?, b, margin)
+    }
+
+    /// [`Proximity::pairs_within`] with a pose whose matrix deviates from a
+    /// rotation by `dev` (as [`Proximity::distance_checked`]).
+    pub(crate) fn pairs_within_checked(
+        &mut self,
+        a: &Mesh<BV>,
+        pose: &Affine3A,
+        dev: f32,
+        b: &Mesh<BV>,
+        margin: f64,
+    ) -> Result<NearPairs> {
         check_margin(margin, "margin")?;
         let mut pairs = Vec::new();
         let cut = Cut {
             value: margin,
             inclusive: true,
         };
-        let counters = self.run(a, pose, b, Order::DepthFirst, cut, Goal::All(&mut pairs))?;
+        let goal = Goal::All(&mut pairs);
+        let counters = self.run(a, pose, dev, b, Order::DepthFirst, cut, goal)?;
         Ok(NearPairs { pairs, counters })
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn run(
         &mut self,
         a: &Mesh<BV>,
         pose: &Affine3A,
+        dev: f32,
         b: &Mesh<BV>,
         order: Order,
         mut cut: Cut,
         mut goal: Goal,
     ) -> Result<CostCounters> {
-        let dev = pose_deviation(pose)?;
         // A mesh's tree always matches its geometry: nothing else to check.
         let (ta, ma) = (a.bvh(), a.trimesh());
         let (tb, mb) = (b.bvh(), b.trimesh());

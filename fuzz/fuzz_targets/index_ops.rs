@@ -1,10 +1,8 @@
 //! Random operation sequences on every index against `BruteForce`, `validate()`
-//! after each (the decoder and the checks are shared with the proptest suite).
+//! after each (the decoder and the checks, `proxima_harness::ops`, are shared
+//! with the proptest suite).
 #![no_main]
 
-#[path = "../../crates/proxima/tests/ops/runner.rs"]
-mod runner;
-
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
-    runner::run(data);
+    proxima_harness::ops::run(data);
 });

@@ -1,15 +1,9 @@
 //! `proxima replay` on arbitrary bytes: the trace parser must return a trace or a
 //! one-line error, and every index must then replay the trace with the same answers
-//! as brute force. The CLI's modules are compiled in with `#[path]`.
+//! as brute force. The parser and the engine are the CLI's, from `proxima_harness`.
 #![no_main]
-#![allow(dead_code)]
 
-#[path = "../../crates/proxima-cli/src/indices.rs"]
-mod indices;
-#[path = "../../crates/proxima-cli/src/replay.rs"]
-mod replay;
-#[path = "../../crates/proxima-cli/src/trace.rs"]
-mod trace;
+use proxima_harness::{replay, trace};
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     let Ok(t) = trace::Trace::parse(data) else {

@@ -1,14 +1,13 @@
-//! `triangles_intersect` against the exact reference of the test suite (built
-//! from the `robust` predicates with a different decomposition), and its
+//! `triangles_intersect` against the exact reference of the test suite
+//! (`proxima_harness::tri_tri`, built from the `robust` predicates with a
+//! different decomposition), and its
 //! invariance under argument order and vertex order; and the prepared path used by
 //! the BVH collision queries (`narrow::PreparedTriangle::intersects`, an `f64`
 //! filter in front of the exact test) against the same reference.
 #![no_main]
 
-#[path = "../../crates/proxima/tests/tri_tri/reference.rs"]
-mod reference;
-
 use proxima::glam::Vec3;
+use proxima_harness::tri_tri as reference;
 use proxima::narrow::{triangles_intersect, PreparedTriangle};
 
 /// Coordinates on a small integer grid (many exact touches and coplanar cases)

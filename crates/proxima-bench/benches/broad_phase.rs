@@ -1,6 +1,6 @@
 //! Broad-phase frame time (update every object + find all pairs) on the standard
 //! workloads, for every Proxima index and parry3d in the same run:
-//! W1 at 10k and 100k, W2 and W3 at 100k. Pair counts are checked equal across
+//! W1 at 10k and 100k, W2, W3 and W9 at 100k. Pair counts are checked equal across
 //! structures on every frame (a mismatch panics).
 //!
 //! `cargo bench -p proxima-bench --bench broad_phase [-- FILTER]`
@@ -8,7 +8,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode};
 use proxima_bench::registry::entries;
 use proxima_bench::run::PairLedger;
-use proxima_bench::workloads::{Kind, Workload};
+use proxima_harness::workloads::{Kind, Workload};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -46,6 +46,7 @@ fn broad_phase(c: &mut Criterion) {
     workload_group(c, Kind::W1, 100_000);
     workload_group(c, Kind::W2, 100_000);
     workload_group(c, Kind::W3, 100_000);
+    workload_group(c, Kind::W9, 100_000);
 }
 
 criterion_group!(benches, broad_phase);

@@ -4,7 +4,7 @@
 //! `cargo run --release -p proxima-bench --example grid3d_par_pairs -- [N] [FRAMES]`
 
 use proxima::broad::{ParallelPairs, SpatialIndex, SpatialIndexExt, UniformGrid3d};
-use proxima_bench::workloads::{Kind, Workload};
+use proxima_harness::workloads::{Kind, Workload};
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 

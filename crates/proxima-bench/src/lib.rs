@@ -1,11 +1,12 @@
 //! # proxima-bench
 //!
 //! Proxima's performance record for the broad phase: the standard workloads
-//! [sources: workloads] (W1 dynamic spheres, W2 flat world, W3 clustered), run through every
-//! Proxima index and the peer crates side by side, with the pair count of every
-//! frame checked equal across all of them.
+//! [sources: workloads] (W1 dynamic spheres, W2 flat world, W3 clustered, W9 mixed
+//! sizes), run through every Proxima index and the peer crates side by side, with
+//! the pair count of every frame checked equal across all of them.
 //!
-//! - [`workloads`]: the deterministic scene generators;
+//! - the deterministic scene generators and their motion model are
+//!   `proxima_harness::workloads` (shared with `proxima demo`);
 //! - [`structure`]: the object-safe [`structure::Structure`] interface and the
 //!   adapter over the library's `AnyIndex<u32>`;
 //! - [`parry`]: the parry3d BVH adapter;
@@ -32,4 +33,3 @@ pub mod w4;
 pub mod w5;
 pub mod w5_distance;
 pub mod w6;
-pub mod workloads;

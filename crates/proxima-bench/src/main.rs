@@ -1,4 +1,4 @@
-//! `proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only A,B] [--clock cpu|wall] [--threads K] [--json]`
+//! `proxima-bench w1|w2|w3|w9 [--n N] [--frames F] [--seed S] [--only A,B] [--clock cpu|wall] [--threads K] [--json]`
 //! `proxima-bench w5 …` (see `proxima_bench::w5`), `w5-distance …` (`proxima_bench::w5_distance`)
 //! `proxima-bench chart FILE.json... --out FILE.svg [--metric NAME]`
 //!
@@ -14,11 +14,11 @@
 use proxima_bench::registry::{self, QUADRATIC_LIMIT};
 use proxima_bench::report;
 use proxima_bench::run::{measure_all_threads, num, Clock};
-use proxima_bench::workloads::Kind;
+use proxima_harness::workloads::Kind;
 use std::process::ExitCode;
 
 const USAGE: &str =
-    "usage: proxima-bench w1|w2|w3 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--threads K] [--json]\n       proxima-bench w4 [--help]\n       proxima-bench w5 [--help]\n       proxima-bench w5-distance [--help]\n       proxima-bench w6 [--help]\n       proxima-bench chart FILE.json... --out FILE.svg [--metric NAME] [--title T]";
+    "usage: proxima-bench w1|w2|w3|w9 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--threads K] [--json]\n       proxima-bench w4 [--help]\n       proxima-bench w5 [--help]\n       proxima-bench w5-distance [--help]\n       proxima-bench w6 [--help]\n       proxima-bench chart FILE.json... --out FILE.svg [--metric NAME] [--title T]";
 
 struct Args {
     kind: Kind,

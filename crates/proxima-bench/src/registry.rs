@@ -3,8 +3,8 @@
 
 use crate::parry::ParryBvh;
 use crate::structure::{Indexed, Structure};
-use crate::workloads::Scene;
 use proxima::broad::IndexKind;
+use proxima_harness::workloads::Scene;
 
 /// One benchmarked structure: a name and how to make it empty for a scene.
 pub struct Entry {

@@ -3,7 +3,7 @@
 
 use crate::registry::Entry;
 use crate::structure::Structure;
-use crate::workloads::{Kind, Workload};
+use proxima_harness::workloads::{Kind, Workload};
 use std::time::{Duration, Instant};
 
 /// What the timings measure.

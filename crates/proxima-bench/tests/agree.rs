@@ -3,7 +3,7 @@
 
 use proxima_bench::registry::entries;
 use proxima_bench::run::{measure, Clock, PairLedger};
-use proxima_bench::workloads::{Kind, Workload};
+use proxima_harness::workloads::{Kind, Workload};
 
 /// Pair count by the definition (exact closed test on every pair).
 fn brute(w: &Workload) -> u64 {

@@ -21,11 +21,12 @@
 //! (and line), exit code 2.
 
 use proxima::geom::{Aabb, Sphere};
-use proxima::glam::{Affine3A, Mat3, Vec3};
+use proxima::glam::Affine3A;
 use proxima::narrow::{
     BoundingVolume, BuildOptions, Collider, CostCounters, Kdop14, Kdop18, Kdop26, Mesh, Obb,
     Proximity, RotationUpdate, SplitRule, TriMesh,
 };
+use proxima_harness::poses;
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -150,44 +151,6 @@ fn parse_args(args: &[String]) -> Result<Args, String> {
     Ok(out)
 }
 
-/// Parses a pose file: one pose per line (12 numbers), `#` comments, blank lines.
-/// Errors name the file and line.
-pub fn parse_poses(name: &str, text: &str) -> Result<Vec<Affine3A>, String> {
-    let mut poses = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let line = line.split('#').next().unwrap_or("");
-        if line.trim().is_empty() {
-            continue;
-        }
-        let at = |msg: String| format!("{name}:{}: {msg}", i + 1);
-        let nums: Vec<f32> = line
-            .split_whitespace()
-            .map(|t| {
-                t.parse::<f32>()
-                    .map_err(|_| at(format!("'{t}' is not a number")))
-                    .and_then(|v| {
-                        if v.is_finite() {
-                            Ok(v)
-                        } else {
-                            Err(at(format!("'{t}' is not finite")))
-                        }
-                    })
-            })
-            .collect::<Result<_, _>>()?;
-        if nums.len() != 12 {
-            return Err(at(format!("expected 12 numbers, found {}", nums.len())));
-        }
-        // Row-major in the file; glam is column-major.
-        let r = Mat3::from_cols_array(&[
-            nums[0], nums[3], nums[6], nums[1], nums[4], nums[7], nums[2], nums[5], nums[8],
-        ]);
-        let pose = Affine3A::from_mat3_translation(r, Vec3::new(nums[9], nums[10], nums[11]));
-        proxima::narrow::check_pose(&pose).map_err(|e| at(e.to_string()))?;
-        poses.push(pose);
-    }
-    Ok(poses)
-}
-
 fn load(path: &str) -> Result<TriMesh, String> {
     proxima::io::load(path).map_err(|e| {
         let s = e.to_string();
@@ -222,7 +185,7 @@ fn run(args: &[String]) -> Result<String, String> {
         None => vec![Affine3A::IDENTITY],
         Some(p) => {
             let text = std::fs::read_to_string(p).map_err(|e| format!("{p}: {e}"))?;
-            parse_poses(p, &text)?
+            poses::parse(p, &text)?
         }
     };
     match args.bv.as_str() {
@@ -336,25 +299,6 @@ fn significant9(x: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn pose_file_parsing_and_errors() {
-        let ok = "# header\n1 0 0 0 1 0 0 0 1 1 2 3\n\n0 -1 0 1 0 0 0 0 1 0 0 0 # z 90\n";
-        let p = parse_poses("p.txt", ok).unwrap();
-        assert_eq!(p.len(), 2);
-        assert_eq!(Vec3::from(p[0].translation), Vec3::new(1.0, 2.0, 3.0));
-        // Row-major: the second pose maps x to y.
-        let x = p[1].transform_vector3(Vec3::X);
-        assert!((x - Vec3::Y).length() < 1e-6);
-        let e = parse_poses("p.txt", "1 0 0 0 1 0 0 0 1 1 2\n").unwrap_err();
-        assert!(e.starts_with("p.txt:1:"), "{e}");
-        let e = parse_poses("p.txt", "\n1 0 0 0 1 0 0 0 1 1 2 x\n").unwrap_err();
-        assert!(e.starts_with("p.txt:2:"), "{e}");
-        let e = parse_poses("p.txt", "1 0 0 0 1 0 0 0 1 1 2 NaN\n").unwrap_err();
-        assert!(e.starts_with("p.txt:1:"), "{e}");
-        let e = parse_poses("p.txt", "2 0 0 0 1 0 0 0 1 1 2 3\n").unwrap_err();
-        assert!(e.starts_with("p.txt:1:") && e.contains("rotation"), "{e}");
-    }
 
     #[test]
     fn argument_errors() {

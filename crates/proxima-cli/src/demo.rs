@@ -1,7 +1,12 @@
 //! `proxima demo`, the main job and what `proxima` does without a command
-//! [sources: cli]: a generated scene of moving spheres [sources: w1, w2, w3] through
-//! every broad-phase index, with a progress bar per index, a comparison table and
-//! pictures.
+//! [sources: cli]: a generated scene of moving spheres [sources: w1, w2, w3, w9]
+//! through every broad-phase index, with a progress bar per index, a comparison
+//! table and pictures.
+//!
+//! The scenes are the benchmarks' workloads, with their one motion model
+//! ([`proxima_harness::workloads`]): `--scene uniform|flat|clustered|mixed` is
+//! W1, W2, W3 or W9, so a demo run and a `proxima-bench` run of the same size and
+//! seed see the same frames.
 //!
 //! A frame = update every sphere, then find all overlapping pairs. Every index
 //! replays the same frames (the scene is regenerated from its seed for each
@@ -12,11 +17,11 @@
 //! the run fails with exit code 1.
 
 use crate::draw::Canvas;
-use crate::indices::{self, BRUTE};
 use crate::pictures::{self, Series};
-use crate::scene::{Scene, SceneKind};
 use indicatif::{ProgressBar, ProgressStyle};
 use proxima::broad::{AnyIndex, IndexKind, SpatialIndex};
+use proxima_harness::indices::{self, BRUTE};
+use proxima_harness::workloads::{Kind, Workload};
 use std::io::IsTerminal;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
@@ -34,12 +39,26 @@ const BRUTE_BUDGET: f64 = 3.8e9;
 /// Largest accepted scene (the pictures and brute force stay bounded).
 const MAX_OBJECTS: usize = 5_000_000;
 
+/// The scene names `--scene` takes, in [`Kind::ALL`] order.
+const SCENES: &str = "uniform, flat, clustered, mixed";
+
+/// Parses `--scene` (a [`Kind::scene_name`]).
+fn parse_scene(s: &str) -> Result<Kind, String> {
+    Kind::from_scene_name(s).ok_or_else(|| format!("unknown scene '{s}' (known: {SCENES})"))
+}
+
 /// Options of `proxima demo` (also accepted by `proxima` without a command).
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// Scene: uniform (W1, a cube), flat (W2, 1000 x 1000 x 10) or clustered (W3).
-    #[arg(long, default_value = "uniform", value_name = "uniform|flat|clustered")]
-    pub scene: SceneKind,
+    /// Scene: uniform (W1, a cube), flat (W2, 1000 x 1000 x 10), clustered (W3)
+    /// or mixed (W9, W1 with power-law radii from 0.25 to 16).
+    #[arg(
+        long,
+        default_value = "uniform",
+        value_name = "uniform|flat|clustered|mixed",
+        value_parser = parse_scene
+    )]
+    pub scene: Kind,
     /// Number of spheres.
     #[arg(long, default_value_t = N, value_name = "N")]
     pub objects: usize,
@@ -69,7 +88,7 @@ pub struct Args {
 impl Default for Args {
     fn default() -> Self {
         Args {
-            scene: SceneKind::Uniform,
+            scene: Kind::W1,
             objects: N,
             frames: FRAMES,
             seed: SEED,
@@ -119,7 +138,7 @@ impl Row {
 /// Runs a scene through one index: build from frame 0, then frames `1..=frames`,
 /// searching pairs on the frames where `search[f - 1]` is true.
 struct Frames<'a> {
-    kind: SceneKind,
+    kind: Kind,
     n: usize,
     seed: u64,
     search: &'a [bool],
@@ -129,10 +148,10 @@ struct Frames<'a> {
 impl Frames<'_> {
     /// Runs the scene on the empty `index` called `name`.
     fn run(&self, name: &'static str, mut index: AnyIndex<u64>) -> proxima::Result<Row> {
-        let mut scene = Scene::new(self.kind, self.n, self.seed);
+        let mut w = Workload::new(self.kind, self.n, self.seed);
         let start = Instant::now();
-        let handles = scene
-            .spheres()
+        let handles = w
+            .spheres
             .iter()
             .enumerate()
             .map(|(i, s)| index.insert(*s, i as u64))
@@ -142,9 +161,9 @@ impl Frames<'_> {
         let mut pair_counts = Vec::with_capacity(self.search.len());
         let mut frame_ms = Vec::with_capacity(self.search.len());
         for &search in self.search {
-            scene.step();
+            w.step();
             let start = Instant::now();
-            for (h, s) in handles.iter().zip(scene.spheres()) {
+            for (h, s) in handles.iter().zip(&w.spheres) {
                 index.update(*h, *s)?;
             }
             let up = start.elapsed();
@@ -258,10 +277,10 @@ fn run(args: &Args) -> Result<ExitCode, String> {
         ));
     };
     let (n, frames) = (args.objects, args.frames);
-    let scene0 = Scene::new(args.scene, n, args.seed);
-    let hint = scene0.hint();
-    let describe = scene0.kind().describe(n, &scene0.world());
-    drop(scene0);
+    let w0 = Workload::new(args.scene, n, args.seed);
+    let hint = w0.scene().hint();
+    let describe = w0.describe();
+    drop(w0);
     let brute_mask = sample_frames(frames, brute_frames(n, frames));
     let all_mask = vec![true; frames];
     let checked: Vec<usize> = (1..=frames).filter(|f| brute_mask[f - 1]).collect();
@@ -362,7 +381,7 @@ fn run(args: &Args) -> Result<ExitCode, String> {
 
     if args.json {
         let json = serde_json::json!({
-            "scene": args.scene.name(),
+            "scene": args.scene.scene_name(),
             "objects": n,
             "frames": frames,
             "seed": args.seed,
@@ -454,13 +473,13 @@ fn run(args: &Args) -> Result<ExitCode, String> {
 fn write_pictures(args: &Args, rows: &[Row], describe: &str) -> Result<Vec<PathBuf>, String> {
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    let mut scene = Scene::new(args.scene, args.objects, args.seed);
+    let mut w = Workload::new(args.scene, args.objects, args.seed);
     for _ in 0..args.frames {
-        scene.step();
+        w.step();
     }
-    let hint = scene.hint();
+    let hint = w.scene().hint();
     let ext = if args.svg { "svg" } else { "png" };
-    let name = args.scene.name();
+    let name = args.scene.scene_name();
     let mut out = Vec::new();
     let mut save = |c: Canvas, what: &str| -> Result<(), String> {
         let p = args.out.join(format!("{name}-{what}.{ext}"));
@@ -468,11 +487,8 @@ fn write_pictures(args: &Args, rows: &[Row], describe: &str) -> Result<Vec<PathB
         out.push(p);
         Ok(())
     };
-    save(pictures::kd_partition(scene.spheres(), &hint)?, "loose-kd")?;
-    save(
-        pictures::octree_partition(scene.spheres(), &hint)?,
-        "octree",
-    )?;
+    save(pictures::kd_partition(&w.spheres, &hint)?, "loose-kd")?;
+    save(pictures::octree_partition(&w.spheres, &hint)?, "octree")?;
     let series: Vec<Series> = rows
         .iter()
         .map(|r| Series {
@@ -547,8 +563,8 @@ mod tests {
 
     #[test]
     fn every_index_runs_a_small_scene_alike() {
-        for kind in SceneKind::ALL {
-            let w = Scene::new(kind, 400, 5);
+        for kind in Kind::ALL {
+            let w = Workload::new(kind, 400, 5);
             let bar = ProgressBar::hidden();
             let search = [true, false, true];
             let rows: Vec<Row> = indices::NAMES
@@ -561,13 +577,17 @@ mod tests {
                         search: &search,
                         bar: &bar,
                     };
-                    let index = n.parse::<IndexKind>().unwrap().build(&w.hint()).unwrap();
+                    let index = n
+                        .parse::<IndexKind>()
+                        .unwrap()
+                        .build(&w.scene().hint())
+                        .unwrap();
                     job.run(n, index).unwrap()
                 })
                 .collect();
             assert!(pair_mismatch(&rows).is_none());
             assert_eq!(rows[0].pair_counts[1], None);
-            if kind != SceneKind::Flat {
+            if kind != Kind::W2 {
                 assert!(rows[0].pair_counts[0].unwrap() > 0);
             }
         }

@@ -1,17 +1,16 @@
 //! `proxima`: the command-line tool of the Proxima library [sources: cli].
 //!
 //! This file only parses arguments and dispatches; each command lives in its own
-//! module, and the broad-phase indices they run are listed once in [`indices`].
+//! module. What the commands share with the benchmarks, fuzz targets and tests
+//! (the index names, the scene generators, the trace parser and replay engine) is
+//! in the `proxima-harness` crate.
 
 mod collide;
 mod demo;
 mod draw;
-mod indices;
 mod pictures;
 mod render;
 mod replay;
-mod scene;
-mod trace;
 
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};

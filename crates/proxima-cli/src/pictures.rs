@@ -4,8 +4,9 @@
 //! intersecting triangles.
 
 use crate::draw::{palette, Anchor, Canvas, Rgba, BLACK, GREY};
-use crate::indices::SceneHint;
-use proxima::broad::{LinearOctree, LooseKdConfig, LooseKdTree, OctreeConfig, SpatialIndex};
+use proxima::broad::{
+    LinearOctree, LooseKdConfig, LooseKdTree, OctreeConfig, SceneHint, SpatialIndex,
+};
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::{Affine3A, Vec3};
 use proxima::narrow::TriMesh;

@@ -11,14 +11,14 @@
 //! takes the first pose of a file), with the triangles that intersect in red.
 //! Exit codes: 0 success, 2 bad input (one line naming the file and line).
 
-use crate::collide::parse_poses;
 use crate::draw::Canvas;
-use crate::indices::SceneHint;
 use crate::pictures;
-use crate::trace::{Op, Trace};
+use proxima::broad::SceneHint;
 use proxima::geom::Sphere;
 use proxima::glam::Affine3A;
 use proxima::narrow::Mesh;
+use proxima_harness::poses;
+use proxima_harness::trace::{Op, Trace};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -139,11 +139,11 @@ fn collide(args: &Args, files: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
     };
     let (a, b) = (load(&files[0])?, load(&files[1])?);
     let pose = if let Some(nums) = &args.pose {
-        parse_poses("--pose", &nums.join(" "))?[0]
+        poses::parse("--pose", &nums.join(" "))?[0]
     } else if let Some(p) = &args.poses {
         let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
         let name = p.display().to_string();
-        *parse_poses(&name, &text)?
+        *poses::parse(&name, &text)?
             .first()
             .ok_or_else(|| format!("{name}: no pose in the file"))?
     } else {

@@ -101,7 +101,7 @@ fn demo_prints_a_table_with_equal_pairs_and_writes_pngs() {
 
 #[test]
 fn demo_json_parses_for_each_scene() {
-    for scene in ["uniform", "flat", "clustered"] {
+    for scene in ["uniform", "flat", "clustered", "mixed"] {
         let o = proxima(&[
             "demo",
             "--scene",

@@ -12,6 +12,7 @@ use proxima::broad::{
 use proxima::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};
 use proxima::glam::{vec3, Mat4, Vec3};
 use proxima::{Error, Handle};
+use proxima_harness::oracle::make_index;
 use std::collections::BTreeSet;
 use std::ops::ControlFlow;
 
@@ -19,19 +20,10 @@ fn world() -> Aabb {
     Aabb::new(Vec3::ZERO, Vec3::splat(100.0))
 }
 
-/// The index of `kind` these tests run: each config's `for_scene` over
-/// `world()` with radius 2, except a denser loose k-d tree (deeper nodes).
+/// The index of `kind` these tests run: the harness's [`make_index`] over
+/// `world()` with radius 2 (each config's `for_scene`, a denser loose k-d tree).
 fn make(kind: IndexKind) -> AnyIndex<u32> {
-    let hint = SceneHint::new(world(), 2.0);
-    match kind {
-        IndexKind::LooseKd => LooseKdTree::with_config(LooseKdConfig {
-            density: 0.5,
-            ..LooseKdConfig::for_scene(&hint)
-        })
-        .unwrap()
-        .into(),
-        _ => kind.build(&hint).unwrap(),
-    }
+    make_index(kind, &SceneHint::new(world(), 2.0))
 }
 
 /// One test function per index kind, each calling `$body(make)`.

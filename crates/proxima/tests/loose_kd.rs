@@ -3,11 +3,8 @@
 //! densities, a depth cap low enough that capped nodes hold many spheres, and an
 //! `R_max` far below the scenes' radii (nearly everything attached at the root).
 
-#[path = "oracle/harness.rs"]
-mod harness;
-
-use harness::{run, SceneParams, ALL_SCENES};
 use proxima::broad::{LooseKdConfig, LooseKdTree};
+use proxima_harness::oracle::{run, SceneParams, ALL_SCENES};
 
 const OPS: usize = 3000;
 

@@ -5,10 +5,6 @@
 //! (`cargo test -p proxima --features parallel --test loose_kd_par`).
 #![cfg(feature = "parallel")]
 
-#[path = "oracle/harness.rs"]
-mod harness;
-
-use harness::{run, SceneParams, ALL_SCENES};
 use proxima::broad::{
     BruteForce, IndexKind, LooseKdConfig, LooseKdTree, ParallelPairs, Query, RayHit, SpatialIndex,
     SpatialIndexExt,
@@ -16,6 +12,7 @@ use proxima::broad::{
 use proxima::geom::{Ray, Sphere};
 use proxima::glam::Vec3;
 use proxima::{Handle, Result};
+use proxima_harness::oracle::{run, SceneParams, ALL_SCENES};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::ops::ControlFlow;

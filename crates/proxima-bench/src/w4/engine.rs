@@ -145,7 +145,7 @@ impl Engine for Proxima {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::workloads::{Kind, Workload};
+    use proxima_harness::workloads::{Kind, Workload};
 
     #[test]
     fn morton_order_is_a_permutation_that_keeps_neighbours_close() {

@@ -23,9 +23,9 @@ pub mod rstar_peer;
 
 use crate::registry::QUADRATIC_LIMIT;
 use crate::run::{median, num, Clock};
-use crate::workloads::{cube_side, Kind, Scene, Workload};
 use engine::{Engine, Proxima};
 use proxima::broad::IndexKind;
+use proxima_harness::workloads::{cube_side, Kind, Scene, Workload};
 use queries::QueryKind;
 use std::fmt::Write;
 use std::time::Duration;

@@ -107,7 +107,7 @@ pub fn generate(side: f32, q: usize, frusta: usize, seed: u64) -> Batches {
         .map(|i| {
             let (o, d) = (
                 point(&mut rng, side),
-                crate::workloads::unit_vector(&mut rng),
+                proxima_harness::workloads::unit_vector(&mut rng),
             );
             if i % 2 == 0 {
                 Ray::with_max_t(o, d, rng.gen_range(5.0..=20.0))

@@ -6,30 +6,9 @@ use proxima::narrow::TriMesh;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-/// Parses a pose file [sources: pose-format]: 12 numbers per line, a row-major rotation
-/// then a translation; `#` comments and blank lines skipped. Errors name the line.
-pub fn parse(name: &str, text: &str) -> Result<Vec<Affine3A>, String> {
-    let mut poses = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let line = line.split('#').next().unwrap_or("");
-        if line.trim().is_empty() {
-            continue;
-        }
-        let n: Vec<f32> = line
-            .split_whitespace()
-            .map(|t| t.parse::<f32>().ok().filter(|v| v.is_finite()))
-            .collect::<Option<_>>()
-            .ok_or_else(|| format!("{name}:{}: not a finite number", i + 1))?;
-        if n.len() != 12 {
-            return Err(format!("{name}:{}: expected 12 numbers", i + 1));
-        }
-        let r = Mat3::from_cols_array(&[n[0], n[3], n[6], n[1], n[4], n[7], n[2], n[5], n[8]]);
-        let p = Affine3A::from_mat3_translation(r, Vec3::new(n[9], n[10], n[11]));
-        proxima::narrow::check_pose(&p).map_err(|e| format!("{name}:{}: {e}", i + 1))?;
-        poses.push(p);
-    }
-    Ok(poses)
-}
+/// Parses a pose file [sources: pose-format] (the CLI's parser, shared through
+/// `proxima_harness::poses`). Errors name the line.
+pub use proxima_harness::poses::parse;
 
 fn bounds(m: &TriMesh) -> (Vec3, f32) {
     let (lo, hi) = m.vertices().iter().fold(

@@ -78,8 +78,14 @@ impl EmbreeRun {
 }
 
 fn ns(s: &str) -> Result<Duration, String> {
+    time(s, 1e-9)
+}
+
+/// A time of `unit` seconds, parsed as a float (scaling a rounded nanosecond
+/// `Duration` up would lose the fraction: `2.5` ms must not become 3 ms).
+fn time(s: &str, unit: f64) -> Result<Duration, String> {
     let x: f64 = s.parse().map_err(|_| format!("w6_rays: bad time {s:?}"))?;
-    Ok(Duration::from_secs_f64(x.max(0.0) * 1e-9))
+    Ok(Duration::from_secs_f64(x.max(0.0) * unit))
 }
 
 /// Parses the harness's output for `n` rays.
@@ -102,7 +108,7 @@ pub fn parse(out: &str, n: usize) -> Result<EmbreeRun, String> {
                 run.answers.push(Some((tri, t)));
             }
             ["#", "lib", rest @ ..] => run.lib = rest.join(" "),
-            ["#", "build_ms", ms, ..] => run.build = ns(ms)? * 1_000_000,
+            ["#", "build_ms", ms, ..] => run.build = time(ms, 1e-3)?,
             ["#", "threads", _, k] => run.threads = k.parse().map_err(|_| line.to_string())?,
             ["#", "ns_per_ray", mode, one, many] => run.modes.push(Mode {
                 name: mode.to_string(),

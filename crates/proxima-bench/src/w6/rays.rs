@@ -3,6 +3,7 @@
 use proxima::geom::{Aabb, Ray};
 use proxima::glam::Vec3;
 use proxima::narrow::TriMesh;
+use proxima_harness::workloads::unit_vector;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -14,20 +15,6 @@ pub fn bounds(mesh: &TriMesh) -> Aabb {
         b.max = b.max.max(p);
     }
     b
-}
-
-fn unit(rng: &mut Pcg64) -> Vec3 {
-    loop {
-        let v = Vec3::new(
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-        );
-        let l = v.length_squared();
-        if l > 1e-4 && l <= 1.0 {
-            return v / l.sqrt();
-        }
-    }
 }
 
 fn inside(rng: &mut Pcg64, lo: Vec3, hi: Vec3) -> Vec3 {
@@ -54,7 +41,7 @@ pub fn rays(mesh: &TriMesh, n: usize, seed: u64) -> Vec<Ray> {
     (0..n)
         .map(|i| match i % 10 {
             0..=4 | 8 | 9 => {
-                let o = c + unit(&mut rng) * (2.0 * r);
+                let o = c + unit_vector(&mut rng) * (2.0 * r);
                 let target = inside(&mut rng, b.min, b.max);
                 let d = target - o;
                 let len = d.length();
@@ -67,7 +54,7 @@ pub fn rays(mesh: &TriMesh, n: usize, seed: u64) -> Vec<Ray> {
             }
             _ => {
                 let o = inside(&mut rng, c - 1.5 * h, c + 1.5 * h);
-                Ray::new(o, unit(&mut rng))
+                Ray::new(o, unit_vector(&mut rng))
             }
         })
         .collect()

@@ -7,9 +7,8 @@ use std::process::Command;
 
 /// The CLI's list of indices (the library's `IndexKind`s), so the tests always
 /// cover every index.
-#[path = "../../src/indices.rs"]
-#[allow(dead_code, unused_imports)]
-pub mod indices;
+#[allow(unused_imports)] // not every test file uses it
+pub use proxima_harness::indices;
 
 /// What a run of the binary gave.
 pub struct Out {

@@ -34,7 +34,7 @@
 
 mod any;
 mod brute;
-mod cell_list;
+mod cell_grid;
 mod ext;
 mod filter;
 mod grid2d;

@@ -1,10 +1,9 @@
 //! Bounded property tests: random operation sequences on every index against
 //! `BruteForce` (decoded from bytes by the same runner as the fuzz target
-//! `index_ops`), and regression inputs found by fuzzing.
-
-mod runner;
+//! `index_ops`, `proxima_harness::ops`), and regression inputs found by fuzzing.
 
 use proptest::prelude::*;
+use proxima_harness::ops as runner;
 
 proptest! {
     // Modest case count: CI stays fast; the fuzz target runs the long searches.

@@ -1,22 +1,17 @@
 //! Oracle tests, written once and instantiated for every index: each index runs
 //! long random operation sequences against `BruteForce` in every scene.
 
-mod harness;
-
-use harness::{run, SceneParams, ALL_SCENES};
-use proxima::broad::{
-    AnyIndex, IndexKind, LinearOctree, LooseKdConfig, LooseKdTree, OctreeConfig, SceneHint,
-    SpatialIndex,
-};
+use proxima::broad::{AnyIndex, IndexKind, LinearOctree, OctreeConfig, SpatialIndex};
+use proxima_harness::oracle::{make_index, run, SceneParams, ALL_SCENES};
 
 /// Number of random operations per scene and seed.
 const OPS: usize = 6000;
 
-/// The index of `kind` the suite runs: each config's `for_scene`, except a
-/// small-leaf octree and a denser loose k-d tree (more splits, merges and moves
-/// between nodes per operation).
+/// The index of `kind` the suite runs: the harness's [`make_index`] (each
+/// config's `for_scene`, a denser loose k-d tree), except a small-leaf octree
+/// (more splits and merges per operation).
 fn make(kind: IndexKind, p: &SceneParams) -> AnyIndex<u64> {
-    let hint = SceneHint::new(p.world, p.r_max);
+    let hint = p.hint();
     match kind {
         IndexKind::Octree => LinearOctree::with_config(OctreeConfig {
             max_per_leaf: 4,
@@ -26,13 +21,7 @@ fn make(kind: IndexKind, p: &SceneParams) -> AnyIndex<u64> {
         })
         .unwrap()
         .into(),
-        IndexKind::LooseKd => LooseKdTree::with_config(LooseKdConfig {
-            density: 0.5,
-            ..LooseKdConfig::for_scene(&hint)
-        })
-        .unwrap()
-        .into(),
-        _ => kind.build(&hint).unwrap(),
+        _ => make_index(kind, &hint),
     }
 }
 

@@ -1,5 +1,6 @@
 //! Exactness tests of `proxima::narrow::triangles_intersect` against two
-//! references: `reference` (exact predicates, a different decomposition) and
+//! references: `reference` (`proxima_harness::tri_tri`: exact predicates, a
+//! different decomposition, shared with the `tri_tri` fuzz target) and
 //! `carath` (integer arithmetic, Carathéodory; grid inputs only). The same
 //! checks run `PreparedTriangle::intersects` (the filtered test the BVH queries
 //! use), which must give the exact answer too.
@@ -8,8 +9,9 @@ mod carath;
 mod cases;
 mod prop;
 mod random;
-mod reference;
 mod sym;
+
+use proxima_harness::tri_tri as reference;
 
 /// The answer of the prepared (filtered) test, asserted equal in both orders.
 fn prepared(a: &[proxima::glam::Vec3; 3], b: &[proxima::glam::Vec3; 3]) -> bool {

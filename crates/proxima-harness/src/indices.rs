@@ -1,11 +1,10 @@
-//! The broad-phase indices every command runs: the library's [`IndexKind`]s, by
-//! the names the command line takes. A command parses a name into an
-//! [`IndexKind`], builds the index with [`IndexKind::build`] and drives the
-//! [`AnyIndex`](proxima::broad::AnyIndex) it gets (static dispatch inside each
-//! call).
+//! The broad-phase indices every command, fuzz target and test runs: the
+//! library's [`IndexKind`]s, by the names the command line takes. A user parses a
+//! name into an [`IndexKind`], builds the index with [`IndexKind::build`] and
+//! drives the [`AnyIndex`](proxima::broad::AnyIndex) it gets (static dispatch
+//! inside each call).
 
 use proxima::broad::IndexKind;
-pub use proxima::broad::SceneHint;
 
 /// Names of the indices, in [`IndexKind::ALL`] order (`brute` first).
 pub const NAMES: [&str; IndexKind::ALL.len()] = {

@@ -1,6 +1,6 @@
 //! Operation sequences decoded from raw bytes, run on every index side by side with
-//! `BruteForce`. Shared by the proptest suite (`tests/ops`) and the cargo-fuzz
-//! target `fuzz/fuzz_targets/index_ops.rs` (included there with `#[path]`).
+//! `BruteForce` ([`run`]). Shared by the library's proptest suite
+//! (`crates/proxima/tests/ops`) and the cargo-fuzz target `index_ops`.
 //!
 //! The decoder favours the inputs that break things: a small grid of values (many
 //! exact touches), huge values (1e30, `f32::MAX`), subnormals, NaN, infinities and
@@ -10,7 +10,7 @@
 
 use proxima::broad::{
     BruteForce, Grid2dConfig, Grid3dConfig, HashGrid, HashGridConfig, LinearOctree, LooseKdConfig,
-    LooseKdTree, OctreeConfig, SpatialIndex, SpatialIndexExt, UniformGrid2d, UniformGrid3d,
+    LooseKdTree, OctreeConfig, Query, SpatialIndex, SpatialIndexExt, UniformGrid2d, UniformGrid3d,
 };
 use proxima::geom::{Aabb, Frustum, Plane, Ray, Segment, Sphere};
 use proxima::glam::{Mat4, Vec3};
@@ -24,17 +24,21 @@ pub struct Bytes<'a> {
 }
 
 impl<'a> Bytes<'a> {
+    /// A reader at the start of `data`.
     pub fn new(data: &'a [u8]) -> Self {
         Bytes { data, pos: 0 }
     }
+    /// Whether every byte has been read.
     pub fn done(&self) -> bool {
         self.pos >= self.data.len()
     }
+    /// The next byte (0 past the end).
     pub fn u8(&mut self) -> u8 {
         let b = self.data.get(self.pos).copied().unwrap_or(0);
         self.pos += 1;
         b
     }
+    /// The next four bytes, little-endian.
     pub fn u32(&mut self) -> u32 {
         u32::from_le_bytes([self.u8(), self.u8(), self.u8(), self.u8()])
     }
@@ -72,9 +76,11 @@ impl<'a> Bytes<'a> {
             _ => pick(self.u8(), &[-1.0, -0.0, f32::NAN, f32::INFINITY, -1e-40]),
         }
     }
+    /// Three [`Bytes::coord`]s.
     pub fn vec3(&mut self) -> Vec3 {
         Vec3::new(self.coord(), self.coord(), self.coord())
     }
+    /// A [`Bytes::vec3`] centre and a [`Bytes::radius`] (possibly invalid).
     pub fn sphere(&mut self) -> Sphere {
         Sphere::new(self.vec3(), self.radius())
     }
@@ -126,25 +132,10 @@ impl Named {
     fn get_mut_ok(&mut self, h: Handle) -> Result<u32> {
         self.index.get_mut(h).map(|v| *v)
     }
-    fn sphere_ids(&self, s: &Sphere) -> Result<Vec<u32>> {
+    /// Payload ids of the objects a sphere, box or frustum query reports, sorted.
+    fn ids_in(&self, q: impl Into<Query>) -> Result<Vec<u32>> {
         let mut v = Vec::new();
-        let r = self.index.for_each_in(*s, |_, _, &x| {
-            v.push(x);
-            ControlFlow::Continue(())
-        });
-        ids(r, v)
-    }
-    fn aabb_ids(&self, b: &Aabb) -> Result<Vec<u32>> {
-        let mut v = Vec::new();
-        let r = self.index.for_each_in(*b, |_, _, &x| {
-            v.push(x);
-            ControlFlow::Continue(())
-        });
-        ids(r, v)
-    }
-    fn frustum_ids(&self, f: &Frustum) -> Result<Vec<u32>> {
-        let mut v = Vec::new();
-        let r = self.index.for_each_in(*f, |_, _, &x| {
+        let r = self.index.for_each_in(q, |_, _, &x| {
             v.push(x);
             ControlFlow::Continue(())
         });
@@ -204,7 +195,8 @@ impl Named {
 }
 
 /// Builds brute force plus every index whose decoded constructor parameters are
-/// accepted (a rejected constructor must be an `Err`, never a panic).
+/// accepted (a rejected constructor must be an `Err`, never a panic: panics
+/// otherwise).
 pub fn build(b: &mut Bytes) -> Vec<Named> {
     let mut out: Vec<Named> = vec![Named::new("brute", BruteForce::<u32>::new())];
     // Mostly a sane world; sometimes decoded (possibly invalid) parameters.
@@ -373,7 +365,9 @@ fn check(idx: &[Named], live: usize) {
     same("contents", idx, |i| i.all());
 }
 
-/// Decodes and runs one operation sequence. Panics on any disagreement.
+/// Decodes and runs one operation sequence: panics on any disagreement with
+/// brute force, failed `validate()` or wrong `len()`, so a test or a fuzz target
+/// just calls it. O(bytes × indices × live objects).
 pub fn run(data: &[u8]) {
     let mut b = Bytes::new(data);
     let mut idx = build(&mut b);
@@ -467,19 +461,19 @@ pub fn run(data: &[u8]) {
             }
             8 => {
                 let s = b.sphere();
-                same("sphere query", &idx, |i| i.sphere_ids(&s));
+                same("sphere query", &idx, |i| i.ids_in(s));
                 same("early stop", &idx, |i| i.early_stop(&s));
             }
             9 => {
                 let bx = Aabb::new(b.vec3(), b.vec3());
-                same("aabb query", &idx, |i| i.aabb_ids(&bx));
+                same("aabb query", &idx, |i| i.ids_in(bx));
             }
             10 => {
                 let f = frustum(&mut b);
                 if debug {
                     eprintln!("  {f:?}");
                 }
-                same("frustum query", &idx, |i| i.frustum_ids(&f));
+                same("frustum query", &idx, |i| i.ids_in(f));
             }
             11 | 12 => {
                 let max_t = match b.u8() % 4 {

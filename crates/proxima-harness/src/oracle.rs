@@ -1,8 +1,17 @@
-//! The generic oracle: long seeded random sequences of inserts, moves, removals and
-//! queries run on an index and on `BruteForce` side by side; every answer must be
-//! identical and `validate()` must pass after every operation.
+//! The generic broad-phase oracle [sources: index-trait]: long seeded random
+//! sequences of inserts, moves, removals and queries run on an index and on
+//! `BruteForce` side by side ([`run`]); every answer must be identical and
+//! `validate()` must pass after every operation. The library's suites
+//! (`tests/oracle`, `tests/loose_kd*.rs`) run it on every index and
+//! configuration, and [`make_index`] is the one way they build an index of a kind.
+//!
+//! The scenes here are shapes for operation sequences (random moves, jumps,
+//! resizes, bad input), not the benchmark workloads of [`crate::workloads`].
 
-use proxima::broad::{BruteForce, SpatialIndex, SpatialIndexExt};
+use proxima::broad::{
+    AnyIndex, BruteForce, IndexKind, LooseKdConfig, LooseKdTree, SceneHint, SpatialIndex,
+    SpatialIndexExt,
+};
 use proxima::geom::{Aabb, Frustum, Ray, Segment, Sphere};
 use proxima::glam::{vec3, Mat4, Vec3};
 use proxima::Handle;
@@ -28,6 +37,7 @@ pub enum Scene {
     OnePoint,
 }
 
+/// Every [`Scene`], in declaration order.
 pub const ALL_SCENES: [Scene; 6] = [
     Scene::Uniform,
     Scene::Flat,
@@ -40,10 +50,35 @@ pub const ALL_SCENES: [Scene; 6] = [
 /// What an index constructor is told about the scene: the world box and the
 /// typical largest radius (objects may still exceed either).
 #[derive(Clone, Copy, Debug)]
-#[allow(dead_code)] // each index constructor reads what it needs
 pub struct SceneParams {
+    /// The world box.
     pub world: Aabb,
+    /// The typical largest radius.
     pub r_max: f32,
+}
+
+impl SceneParams {
+    /// The same as the library's hint ([`SceneHint::new`]).
+    pub fn hint(&self) -> SceneHint {
+        SceneHint::new(self.world, self.r_max)
+    }
+}
+
+/// The index of `kind` the test suites run for `hint`: each config's
+/// `for_scene`, except a denser loose k-d tree (density 0.5: deeper nodes, so
+/// more splits, merges and moves between nodes per operation). A suite that
+/// wants another configuration of one kind matches on that kind first and
+/// falls back to this.
+pub fn make_index<T: Send + Sync>(kind: IndexKind, hint: &SceneHint) -> AnyIndex<T> {
+    match kind {
+        IndexKind::LooseKd => LooseKdTree::with_config(LooseKdConfig {
+            density: 0.5,
+            ..LooseKdConfig::for_scene(hint)
+        })
+        .unwrap_or_else(|e| panic!("{kind}: {e}"))
+        .into(),
+        _ => kind.build(hint).unwrap_or_else(|e| panic!("{kind}: {e}")),
+    }
 }
 
 struct Gen {
@@ -234,6 +269,18 @@ fn ids<I: SpatialIndex<u64>>(index: &I, handles: &[Handle]) -> Vec<u64> {
     v
 }
 
+/// Ids and entry `t` bits of every object a ray hits, sorted.
+fn hit_ids<I: SpatialIndex<u64>>(index: &I, r: &Ray) -> Vec<(u64, u32)> {
+    let mut v: Vec<(u64, u32)> = index
+        .ray_hits(r)
+        .unwrap()
+        .iter()
+        .map(|h| (*index.get(h.handle).unwrap().1, h.t.to_bits()))
+        .collect();
+    v.sort_unstable();
+    v
+}
+
 fn pair_ids<I: SpatialIndex<u64>>(index: &I) -> Vec<(u64, u64)> {
     let mut v = Vec::new();
     let _ = index.for_each_pair(|_, a, _, b| {
@@ -249,6 +296,8 @@ fn pair_ids<I: SpatialIndex<u64>>(index: &I) -> Vec<(u64, u64)> {
 
 /// Runs `ops` random operations on `make(params)` and on `BruteForce`, comparing
 /// after each. Panics with the operation number and seed on the first difference.
+/// O(ops × (the index's cost + brute force's O(live) per query)), pairs every
+/// 21 operations.
 pub fn run<I, F>(scene: Scene, seed: u64, ops: usize, make: F)
 where
     I: SpatialIndex<u64>,
@@ -363,21 +412,12 @@ where
                         Segment::new(a, b).to_ray()
                     }
                 };
-                let mut a: Vec<(u64, u32)> = index
-                    .ray_hits(&r)
-                    .unwrap()
-                    .iter()
-                    .map(|h| (*index.get(h.handle).unwrap().1, h.t.to_bits()))
-                    .collect();
-                let mut b: Vec<(u64, u32)> = oracle
-                    .ray_hits(&r)
-                    .unwrap()
-                    .iter()
-                    .map(|h| (*oracle.get(h.handle).unwrap().1, h.t.to_bits()))
-                    .collect();
-                a.sort_unstable();
-                b.sort_unstable();
-                assert_eq!(a, b, "{}: ray hits {r:?}", ctx());
+                assert_eq!(
+                    hit_ids(&index, &r),
+                    hit_ids(&oracle, &r),
+                    "{}: ray hits {r:?}",
+                    ctx()
+                );
                 let fa = index.ray_first(&r).unwrap();
                 let fb = oracle.ray_first(&r).unwrap();
                 assert_eq!(

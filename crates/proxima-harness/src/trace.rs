@@ -1,16 +1,26 @@
-//! Parser of the scene-trace format of `proxima replay` [sources: trace-format].
+//! Parser of the scene-trace format of `proxima replay` [sources: trace-format],
+//! used by the CLI, the `replay` fuzz target and [`crate::replay`].
 //!
 //! The whole trace is parsed and checked before any index runs: syntax, finite
 //! numbers, query shapes (through the library's own `validate`), and id liveness
 //! (insert of a present id, move/remove of an absent one). So every index replays
 //! the same valid operations, and a bad line stops the run before any output.
 //! User ids are mapped once to dense slots, so a replay needs no hashing.
+//!
+//! # Adding a line
+//!
+//! A new line kind (issue #14's `nearest X Y Z K` and `sweep X0 Y0 Z0 X1 Y1 Z1 R`,
+//! say) is a [`Query`] variant, a [`Kind`] (its keyword and table position), one
+//! arm of the parser's `match` on the command (fields read with [`crate::lex`]),
+//! and one arm of the engine's `apply` with its [`crate::replay::Answer`]. An
+//! optional tail on an existing line (`insert ID X Y Z R GROUP MASK`) is read in
+//! that line's arm by its field count, and carried as a field of its [`Op`].
 
-use crate::indices::SceneHint;
+use crate::lex::{self, expect_fields, numbers, ParseError, Res};
+use proxima::broad::SceneHint;
 use proxima::geom::{Aabb, Frustum, Ray, Sphere};
 use proxima::glam::{Mat4, Vec3};
 use std::collections::HashMap;
-use std::fmt;
 
 /// A query of a trace line.
 #[derive(Clone, Debug, PartialEq)]
@@ -55,6 +65,7 @@ pub enum Op {
 
 /// Operation kinds, for timing tables (`kind as usize` indexes [`Kind::ALL`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs)] // each is its keyword (see `Kind::name`)
 pub enum Kind {
     Insert,
     Move,
@@ -123,21 +134,6 @@ pub struct Trace {
     pub max_live: usize,
 }
 
-/// A bad line: printed as `line N: message`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ParseError {
-    /// 1-based line number.
-    pub line: usize,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl fmt::Display for ParseError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "line {}: {}", self.line, self.message)
-    }
-}
-
 /// Most fields on a line (`frustum` and its 16 numbers).
 const MAX_FIELDS: usize = 17;
 
@@ -145,14 +141,13 @@ impl Trace {
     /// Parses and checks a whole trace. O(lines); allocates only the result.
     pub fn parse(text: &[u8]) -> Result<Trace, ParseError> {
         let mut p = Parser::default();
-        for (i, raw) in text.split(|&b| b == b'\n').enumerate() {
-            let line = i + 1;
-            p.line(raw)
-                .map_err(|message| ParseError { line, message })?;
+        lex::for_each_line(text, |line, raw| {
+            p.line(raw)?;
             if p.trace.ops.len() > p.trace.lines.len() {
                 p.trace.lines.push(line as u32);
             }
-        }
+            Ok(())
+        })?;
         Ok(p.trace)
     }
 
@@ -183,30 +178,18 @@ struct Parser {
     live_count: usize,
 }
 
-type Res<T> = Result<T, String>;
-
 impl Parser {
     fn line(&mut self, raw: &[u8]) -> Res<()> {
-        let text = std::str::from_utf8(raw).map_err(|_| "not valid UTF-8".to_string())?;
-        let text = text.split('#').next().unwrap_or("");
-        let mut f = [""; MAX_FIELDS];
-        let mut n = 0;
-        for tok in text.split_ascii_whitespace() {
-            if n == MAX_FIELDS {
-                return Err(format!("too many fields (at most {MAX_FIELDS})"));
-            }
-            f[n] = tok;
-            n += 1;
-        }
-        if n == 0 {
+        let line = lex::Line::<MAX_FIELDS>::split(raw)?;
+        let Some(cmd) = line.command() else {
             return Ok(());
-        }
-        let (cmd, args) = (f[0], &f[1..n]);
+        };
+        let args = line.args();
         let op = match cmd {
             "insert" | "move" => {
-                fields(cmd, args, &["ID", "X", "Y", "Z", "R"])?;
-                let id = parse_id(args[0])?;
-                let sphere = sphere(&args[1..])?;
+                expect_fields(cmd, args, &["ID", "X", "Y", "Z", "R"])?;
+                let id = lex::id(args[0])?;
+                let sphere = lex::sphere(&args[1..])?;
                 if cmd == "insert" {
                     Op::Insert {
                         slot: self.insert(id)?,
@@ -220,19 +203,19 @@ impl Parser {
                 }
             }
             "remove" => {
-                fields(cmd, args, &["ID"])?;
-                let slot = self.live_slot(parse_id(args[0])?)?;
+                expect_fields(cmd, args, &["ID"])?;
+                let slot = self.live_slot(lex::id(args[0])?)?;
                 self.live[slot as usize] = false;
                 self.live_count -= 1;
                 Op::Remove { slot }
             }
             "pairs" => {
-                fields(cmd, args, &[])?;
+                expect_fields(cmd, args, &[])?;
                 Op::Query(Query::Pairs)
             }
             "sphere" => {
-                fields(cmd, args, &["X", "Y", "Z", "R"])?;
-                Op::Query(Query::Sphere(sphere(args)?))
+                expect_fields(cmd, args, &["X", "Y", "Z", "R"])?;
+                Op::Query(Query::Sphere(lex::sphere(args)?))
             }
             "aabb" => {
                 let v = numbers::<6>(cmd, args, &["X0", "Y0", "Z0", "X1", "Y1", "Z1"])?;
@@ -262,7 +245,7 @@ impl Parser {
                     .map_err(|e| format!("bad view-projection matrix: {e}"))?;
                 Op::Query(Query::Frustum(Box::new(fr)))
             }
-            other => return Err(format!("unknown command '{}'", clip(other))),
+            other => return Err(format!("unknown command '{}'", lex::clip(other))),
         };
         self.trace.ops.push(op);
         Ok(())
@@ -292,57 +275,6 @@ impl Parser {
             Some(&s) if self.live[s as usize] => Ok(s),
             _ => Err(format!("unknown id {id}")),
         }
-    }
-}
-
-/// Checks the field count of `cmd`.
-fn fields(cmd: &str, args: &[&str], names: &[&str]) -> Res<()> {
-    if args.len() == names.len() {
-        return Ok(());
-    }
-    let usage = if names.is_empty() {
-        format!("{cmd} takes no fields")
-    } else {
-        format!("{cmd} expects {} fields ({})", names.len(), names.join(" "))
-    };
-    Err(format!("{usage}, got {}", args.len()))
-}
-
-fn parse_id(s: &str) -> Res<u64> {
-    s.parse()
-        .map_err(|_| format!("bad id '{}' (expected an unsigned 64-bit integer)", clip(s)))
-}
-
-/// Parses exactly `N` finite numbers named `names`.
-fn numbers<const N: usize>(cmd: &str, args: &[&str], names: &[&str]) -> Res<[f32; N]> {
-    fields(cmd, args, names)?;
-    let mut v = [0.0; N];
-    for ((out, s), name) in v.iter_mut().zip(args).zip(names) {
-        let x: f32 = s
-            .parse()
-            .map_err(|_| format!("bad number '{}' for {name}", clip(s)))?;
-        if !x.is_finite() {
-            return Err(format!("{name} is not finite ('{}')", clip(s)));
-        }
-        *out = x;
-    }
-    Ok(v)
-}
-
-/// `X Y Z R` as a validated sphere.
-fn sphere(args: &[&str]) -> Res<Sphere> {
-    let v = numbers::<4>("sphere", args, &["X", "Y", "Z", "R"])?;
-    let s = Sphere::new(Vec3::new(v[0], v[1], v[2]), v[3]);
-    s.validate().map_err(|e| e.to_string())?;
-    Ok(s)
-}
-
-/// A token shortened for an error message.
-fn clip(s: &str) -> String {
-    const MAX: usize = 40;
-    match s.char_indices().nth(MAX) {
-        Some((i, _)) => format!("{}…", &s[..i]),
-        None => s.to_string(),
     }
 }
 

@@ -1,0 +1,43 @@
+//! # proxima-harness
+//!
+//! What Proxima's command-line tool, benchmarks, fuzz targets and tests share,
+//! written once (it was compiled into several crates as path includes, or copied).
+//! Not published: the library is `proxima`; this crate drives and checks it.
+//!
+//! | module | what | used by |
+//! |---|---|---|
+//! | [`workloads`] | the standard scenes W1–W3 and W9 [sources: workloads], one motion model | bench, `proxima demo` |
+//! | [`indices`] | the indices by command-line name, brute force first | CLI, CLI tests |
+//! | [`lex`] | line splitting, field and number parsing, `line N:` errors | [`trace`]; the world trace |
+//! | [`trace`] | the scene trace of `proxima replay` [sources: trace-format] | CLI, `replay` fuzz target |
+//! | [`replay`] | a trace run on an index, answers compared with brute force | CLI, `replay` fuzz target |
+//! | [`ops`] | operation sequences decoded from bytes, every index against brute force | `tests/ops`, `index_ops` fuzz target |
+//! | [`poses`] | the pose-file format (12 numbers a line) | `proxima collide`, `proxima render`, W5 bench |
+//! | [`oracle`] | long random sequences on one index against brute force; [`oracle::make_index`] | `tests/oracle`, `tests/loose_kd*.rs`, `tests/extreme.rs` |
+//! | [`tri_tri`] | the exact triangle–triangle reference | `tests/tri_tri`, `tri_tri` fuzz target |
+//!
+//! Everything checks by panicking (`assert!`) or by returning a one-line error
+//! a command prints: the callers are tests, fuzz targets and tools.
+//!
+//! # Where the collision world's pieces go (issue #13)
+//!
+//! Beside each broad-phase piece, its world counterpart: a `world_trace` module
+//! parsing `proxima world`'s format [sources: world-trace] with the same
+//! [`lex`] helpers (a `Line`, `expect_fields`, `numbers`, `ParseError`), a
+//! `world_replay` engine in the shape of [`replay`] (a `Run` of answers per
+//! configuration, the first disagreement with the brute-force world), and a
+//! `world_oracle` with the brute-force world (every object pair, every triangle
+//! pair, [`tri_tri`] available as the exact reference) driven like [`oracle::run`].
+//! New trace lines of issue #14 slot into [`trace`] as described there.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod indices;
+pub mod lex;
+pub mod ops;
+pub mod oracle;
+pub mod poses;
+pub mod replay;
+pub mod trace;
+pub mod tri_tri;
+pub mod workloads;

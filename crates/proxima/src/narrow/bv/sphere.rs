@@ -53,7 +53,7 @@ impl BoundingVolume for Sphere {
 
     /// The radius in `f32` (its rounding is covered by the queries' slack);
     /// where that overflows (coordinates beyond `√f32::MAX ≈ 1.8e19`), from
-    /// [`enclosing_radius`], finite up to `f32::MAX`.
+    /// `enclosing_radius`, finite up to `f32::MAX`.
     fn from_points(points: &[Vec3]) -> Self {
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
@@ -79,7 +79,7 @@ impl BoundingVolume for Sphere {
 
     /// The smallest sphere containing both spheres, in `f32`; where that
     /// overflows (distances beyond `√f32::MAX`), in `f64` with the radius
-    /// rounded up ([`enclosing_radius`]'s containment).
+    /// rounded up (`enclosing_radius`'s containment).
     fn merge(&self, o: &Self) -> Self {
         let d = o.center - self.center;
         let dist = d.length();

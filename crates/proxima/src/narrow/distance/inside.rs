@@ -53,7 +53,7 @@ impl<BV: BoundingVolume> Proximity<BV> {
     /// for every finite input: a point of the surface is found by the exact
     /// [`segment_triangle_intersect`]; otherwise it counts the triangles crossed
     /// by the vertical ray `p + t·z`, `t > 0`, deciding every sign with the exact
-    /// predicates ([`orient2d`] on the triangles' `xy` projections, [`orient3d`]
+    /// predicates (`orient2d` on the triangles' `xy` projections, `orient3d`
     /// for above/below). A ray through an edge or a vertex is resolved by
     /// moving it infinitesimally (simulation of simplicity), so each crossing is
     /// counted once and grazing contacts are not counted. On an open mesh (as the

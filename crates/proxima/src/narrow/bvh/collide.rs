@@ -4,7 +4,7 @@
 
 use super::mesh::Mesh;
 use super::moving::{query_slack, Descent, LowerBounds, Moved, MovingVolumes};
-use super::traverse::traverse;
+use super::traverse::{traverse, Terminal};
 use super::tree::Bvh;
 use super::tri_cache::TriangleCache;
 use crate::narrow::bv::BoundingVolume;
@@ -116,17 +116,8 @@ pub fn check_pose(pose: &Affine3A) -> Result<()> {
 
 /// Checks a pose and returns the deviation of its matrix from a rotation.
 pub(crate) fn pose_deviation(pose: &Affine3A) -> Result<f32> {
-    if !pose.matrix3.is_finite() || !pose.translation.is_finite() {
-        return Err(Error::InvalidPose("pose is not finite".into()));
-    }
+    let dev = rotation_deviation(pose)?;
     let m = pose.matrix3;
-    let d = m.transpose() * m - Mat3A::IDENTITY;
-    let dev = d
-        .x_axis
-        .abs()
-        .max(d.y_axis.abs())
-        .max(d.z_axis.abs())
-        .max_element();
     if dev.is_nan() || dev > MAX_POSE_DEVIATION || m.determinant() <= 0.0 {
         return Err(Error::InvalidPose(format!(
             "matrix is not a rotation (|RᵀR - I| = {dev}, det = {})",
@@ -134,6 +125,23 @@ pub(crate) fn pose_deviation(pose: &Affine3A) -> Result<f32> {
         )));
     }
     Ok(dev)
+}
+
+/// The largest entry of `|RᵀR - I|` of a finite pose, with no limit (the
+/// collision world composes two checked poses, whose product may deviate up to
+/// about twice [`check_pose`]'s limit; the rounding slack grows with it).
+/// Fails only on a non-finite pose.
+pub(crate) fn rotation_deviation(pose: &Affine3A) -> Result<f32> {
+    if !pose.matrix3.is_finite() || !pose.translation.is_finite() {
+        return Err(Error::InvalidPose("pose is not finite".into()));
+    }
+    let m = pose.matrix3;
+    let d = m.transpose() * m - Mat3A::IDENTITY;
+    Ok(d.x_axis
+        .abs()
+        .max(d.y_axis.abs())
+        .max(d.z_axis.abs())
+        .max_element())
 }
 
 impl<BV: BoundingVolume> Collider<BV> {
@@ -210,6 +218,32 @@ impl<BV: BoundingVolume> Collider<BV> {
         custom: Option<&TriangleTest>,
     ) -> Result<CostCounters> {
         let dev = pose_deviation(pose)?;
+        Ok(self
+            .run_from(a, pose, dev, b, first, out, custom, &[(0, 0)], &mut ())
+            .0)
+    }
+
+    /// The query of [`Collider::all_pairs`] (or, with `first`, of
+    /// [`Collider::first_contact`]) for a pose already checked, whose matrix
+    /// deviates from a rotation by `dev` (any finite amount: the rounding slack
+    /// grows with it), starting from the node pairs `start` (the roots, or a cut
+    /// an earlier traversal reported to its `cut`: the same triangle pairs are
+    /// found, possibly in another order) and reporting where it ends to `cut`.
+    /// Appends the intersecting triangle pairs to `out`; returns the counters and
+    /// whether it stopped early (then `cut` saw only part of the cut).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn run_from(
+        &mut self,
+        a: &Mesh<BV>,
+        pose: &Affine3A,
+        dev: f32,
+        b: &Mesh<BV>,
+        first: bool,
+        out: &mut Vec<(u32, u32)>,
+        custom: Option<&TriangleTest>,
+        start: &[(u32, u32)],
+        cut: &mut impl Terminal,
+    ) -> (CostCounters, bool) {
         // A mesh's tree always matches its geometry: nothing else to check.
         let (ta, tb) = (a.bvh(), b.bvh());
         let slack = query_slack(ta, pose, dev, tb);
@@ -253,31 +287,39 @@ impl<BV: BoundingVolume> Collider<BV> {
             a: ta,
             b: tb,
             first,
+            start,
             stack,
             nv: &mut c.nv,
+            cut,
             leaf,
         };
-        c.nu = moving.descend(a, pose, slack, *rotation, d);
+        let (nu, stopped) = moving.descend(a, pose, slack, *rotation, d);
+        c.nu = nu;
         c.np = np;
-        Ok(c)
+        (c, stopped)
     }
 }
 
 /// The collision descent ([`traverse`]) with a leaf-pair test, for any source
 /// of the moving volumes.
-struct Traversal<'q, BV, L> {
+struct Traversal<'q, BV, C, L> {
     a: &'q Bvh<BV>,
     b: &'q Bvh<BV>,
     /// A first-contact query: the more deeply overlapping child pair first.
     first: bool,
+    /// Where the descent starts (the roots, or a recorded cut), and where it
+    /// reports the cut it ends on.
+    start: &'q [(u32, u32)],
     stack: &'q mut Vec<(u32, u32)>,
     nv: &'q mut u64,
+    cut: &'q mut C,
     leaf: L,
 }
 
-impl<BV, L> Descent<BV> for Traversal<'_, BV, L>
+impl<BV, C, L> Descent<BV> for Traversal<'_, BV, C, L>
 where
     BV: BoundingVolume,
+    C: Terminal,
     L: FnMut(&dyn Fn(u32) -> Vec3, usize, usize) -> bool,
 {
     /// Exact volumes for subtrees of at most 4 triangles under `Auto` and
@@ -291,13 +333,16 @@ where
         }
     }
 
+    /// Whether the leaf test stopped the descent.
     #[inline]
-    fn descend(mut self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3) {
+    fn descend(mut self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3) -> bool {
         let leaf = |x, y| (self.leaf)(corner, x, y);
+        let (a, b, start, stack, nv, cut) =
+            (self.a, self.b, self.start, self.stack, self.nv, self.cut);
         if self.first {
-            traverse::<BV, true>(self.a, src, self.b, self.stack, self.nv, leaf);
+            traverse::<BV, true>(a, src, b, start, stack, nv, cut, leaf)
         } else {
-            traverse::<BV, false>(self.a, src, self.b, self.stack, self.nv, leaf);
+            traverse::<BV, false>(a, src, b, start, stack, nv, cut, leaf)
         }
     }
 }

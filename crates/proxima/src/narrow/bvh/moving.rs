@@ -91,7 +91,8 @@ pub(crate) trait Descent<BV: BoundingVolume> {
     /// `f32` values whichever the source). The corner is a type parameter, not
     /// a `dyn`, so that the leaf tests inline it (W5 collision: 5% more
     /// instructions through a `&dyn Fn`).
-    fn descend(self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3);
+    /// Returns whether the descent stopped early (collision's first contact).
+    fn descend(self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3) -> bool;
 }
 
 /// The scratch space of the moving volumes (kept by the query objects: no
@@ -119,7 +120,7 @@ impl<BV: BoundingVolume> MovingVolumes<BV> {
     /// oriented volumes or a pose without rotation; else as
     /// [`Descent::moved`] says for `rotation`: an exact refit of every node,
     /// lazily transformed volumes, or those with exact volumes near the leaves.
-    /// Returns the node updates (`Nu`).
+    /// Returns the node updates (`Nu`) and whether the descent stopped early.
     #[inline]
     pub(crate) fn descend<D: Descent<BV>>(
         &mut self,
@@ -128,7 +129,7 @@ impl<BV: BoundingVolume> MovingVolumes<BV> {
         slack: f32,
         rotation: RotationUpdate,
         d: D,
-    ) -> u64 {
+    ) -> (u64, bool) {
         let (ta, va) = (a.bvh(), a.trimesh().vertices());
         let moved = |v: u32| pose.transform_point3(va[v as usize]);
         if !(BV::AXIS_ALIGNED && pose.matrix3 != Mat3A::IDENTITY) {
@@ -136,8 +137,7 @@ impl<BV: BoundingVolume> MovingVolumes<BV> {
                 nodes: &ta.nodes,
                 motion: BV::motion(pose, slack),
             };
-            d.descend(&mut src, &moved);
-            return 0;
+            return (0, d.descend(&mut src, &moved));
         }
         let MovingVolumes {
             world_vertices,
@@ -150,8 +150,8 @@ impl<BV: BoundingVolume> MovingVolumes<BV> {
             world_vertices.extend(va.iter().map(|&v| pose.transform_point3(v)));
             let nu = ta.world_volumes(world_vertices, slack, world);
             let wv: &[Vec3] = world_vertices;
-            d.descend(&mut Precomputed(world), &|v: u32| wv[v as usize]);
-            return nu;
+            let stopped = d.descend(&mut Precomputed(world), &|v: u32| wv[v as usize]);
+            return (nu, stopped);
         }
         cache.begin(ta.nodes.len(), ta.nodes[0].bv);
         let lazy = Lazy {
@@ -169,12 +169,12 @@ impl<BV: BoundingVolume> MovingVolumes<BV> {
                 sizes: &ta.subtree,
                 below,
             };
-            d.descend(&mut src, &moved);
-            src.lazy.updates
+            let stopped = d.descend(&mut src, &moved);
+            (src.lazy.updates, stopped)
         } else {
             let mut src = lazy;
-            d.descend(&mut src, &moved);
-            src.updates
+            let stopped = d.descend(&mut src, &moved);
+            (src.updates, stopped)
         }
     }
 }

@@ -497,7 +497,7 @@ impl<BV: BoundingVolume> Proximity<BV> {
             cut: &mut cut,
             visit,
         };
-        c.nu = moving.descend(a, pose, slack, *rotation, d);
+        c.nu = moving.descend(a, pose, slack, *rotation, d).0;
         c.np = np;
         self.counters = c;
         Ok(c)
@@ -533,7 +533,8 @@ where
     }
 
     #[inline]
-    fn descend(mut self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3) {
+    /// Never stops early as a whole (the goal keeps its own answer).
+    fn descend(mut self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3) -> bool {
         descend(
             self.a,
             src,
@@ -544,5 +545,6 @@ where
             self.cut,
             |v, cut| (self.visit)(corner, v, cut),
         );
+        false
     }
 }

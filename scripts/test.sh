@@ -56,14 +56,12 @@ rm -rf "$PY_OUT/wheels"
 "$VPY" -m pip install --quiet --disable-pip-version-check --no-deps --force-reinstall \
     "$PY_OUT"/wheels/proxima-*.whl
 
-# The CLI whose answers the collide tests compare with: the one `cargo test`
-# built, or build it.
+# The CLI whose answers the collide tests compare with, built from these
+# sources (a no-op after `cargo test`; a stale binary would give stale answers).
 if [ -z "${PROXIMA_CLI:-}" ]; then
     PROXIMA_CLI=$ROOT/target/debug/proxima
-    if [ ! -x "$PROXIMA_CLI" ]; then
-        say "building the CLI"
-        cargo build --quiet -p proxima-cli
-    fi
+    say "building the CLI"
+    cargo build --quiet -p proxima-cli
 fi
 export PROXIMA_CLI
 

@@ -4,32 +4,31 @@
 //! brute-force world, in all-pairs and first-contact mode, or reject a pose the
 //! parser let through with a typed error. Mesh files are not read: `mesh NAME
 //! FILE` takes FILE from a few built-in meshes (`tri`, `tet`, `cube`, `quad`),
-//! so the fuzzer spends its time on poses and queries. The CLI's modules are
-//! compiled in with `#[path]`.
+//! so the fuzzer spends its time on poses and queries. The parser, the engine
+//! and the brute-force world are the CLI's, from `proxima_harness`.
 #![no_main]
-#![allow(dead_code)]
 
-#[path = "../../crates/proxima-cli/src/world.rs"]
-mod world;
-#[path = "../../crates/proxima-cli/src/world_oracle.rs"]
-mod world_oracle;
-#[path = "../../crates/proxima-cli/src/world_replay.rs"]
-mod world_replay;
-#[path = "../../crates/proxima-cli/src/world_trace.rs"]
-mod world_trace;
-
-use glam::Vec3;
 use proxima::broad::IndexKind;
+use proxima::glam::Vec3;
 use proxima::narrow::TriMesh;
 use proxima::world::WorldConfig;
+use proxima_harness::{world_replay, world_trace};
 
 /// The built-in meshes by file name.
 fn load(file: &str) -> Result<TriMesh, String> {
     let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
     let (vertices, triangles) = match file {
-        "tri" => (vec![v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.)], vec![[0, 1, 2]]),
+        "tri" => (
+            vec![v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.)],
+            vec![[0, 1, 2]],
+        ),
         "quad" => (
-            vec![v(-1., -1., 0.), v(1., -1., 0.), v(1., 1., 0.), v(-1., 1., 0.)],
+            vec![
+                v(-1., -1., 0.),
+                v(1., -1., 0.),
+                v(1., 1., 0.),
+                v(-1., 1., 0.),
+            ],
             vec![[0, 1, 2], [0, 2, 3]],
         ),
         "tet" => (
@@ -38,11 +37,27 @@ fn load(file: &str) -> Result<TriMesh, String> {
         ),
         "cube" => {
             let c = (0..8)
-                .map(|i| v((i & 1) as f32 - 0.5, ((i >> 1) & 1) as f32 - 0.5, (i >> 2) as f32 - 0.5))
+                .map(|i| {
+                    v(
+                        (i & 1) as f32 - 0.5,
+                        ((i >> 1) & 1) as f32 - 0.5,
+                        (i >> 2) as f32 - 0.5,
+                    )
+                })
                 .collect();
             let t = vec![
-                [0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4],
-                [2, 6, 7], [2, 7, 3], [0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5],
+                [0, 2, 3],
+                [0, 3, 1],
+                [4, 5, 7],
+                [4, 7, 6],
+                [0, 1, 5],
+                [0, 5, 4],
+                [2, 6, 7],
+                [2, 7, 3],
+                [0, 4, 6],
+                [0, 6, 2],
+                [1, 3, 7],
+                [1, 7, 5],
             ];
             (c, t)
         }
@@ -67,14 +82,23 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
                 index: Some(kind),
                 ..WorldConfig::default()
             };
-            runs.push((kind.name(), world::run_bv("kdop18", &trace, config, first)));
+            runs.push((
+                kind.name(),
+                world_replay::run_bv("kdop18", &trace, config, first),
+            ));
         }
-        for bv in world::BVS {
-            runs.push((bv, world::run_bv(bv, &trace, WorldConfig::default(), first)));
+        for bv in world_replay::BVS {
+            runs.push((
+                bv,
+                world_replay::run_bv(bv, &trace, WorldConfig::default(), first),
+            ));
         }
         // A pose beyond the world's coordinate limit is an error, not an
         // answer: then every run must reject the same operation.
-        let rejected: Vec<Option<usize>> = runs.iter().map(|(_, r)| r.as_ref().err().map(|e| e.0)).collect();
+        let rejected: Vec<Option<usize>> = runs
+            .iter()
+            .map(|(_, r)| r.as_ref().err().map(|e| e.0))
+            .collect();
         assert!(
             rejected.iter().all(|r| *r == rejected[0]),
             "the runs reject different operations: {rejected:?}"

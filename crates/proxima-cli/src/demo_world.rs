@@ -10,10 +10,7 @@
 //! in red.
 
 use crate::draw::Canvas;
-use crate::world_oracle::BruteWorld;
 use crate::world_picture::{closed_outward, world_frame, Drawn};
-use crate::world_replay::WorldAnswer;
-use crate::world_trace::{WorldOp, WorldTrace};
 use indicatif::{ProgressBar, ProgressStyle};
 use proxima::broad::Filter;
 use proxima::geom::{Frustum, Ray, Relation};
@@ -21,6 +18,9 @@ use proxima::glam::{Affine3A, Mat4, Quat, Vec3};
 use proxima::narrow::{BuildOptions, Kdop18, Mesh, TriMesh};
 use proxima::world::{ContactMode, ContactReport, Shape, World, WorldConfig, WorldCounters};
 use proxima::Handle;
+use proxima_harness::world_oracle::BruteWorld;
+use proxima_harness::world_replay::WorldAnswer;
+use proxima_harness::world_trace::{WorldOp, WorldTrace};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::path::{Path, PathBuf};

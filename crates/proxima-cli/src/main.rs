@@ -13,10 +13,7 @@ mod pictures;
 mod render;
 mod replay;
 mod world;
-mod world_oracle;
 mod world_picture;
-mod world_replay;
-mod world_trace;
 
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};

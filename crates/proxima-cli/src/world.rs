@@ -1,18 +1,16 @@
 //! `proxima world TRACE [--index NAME] [--bv NAME] [--first] [--check] [--time]`
 //! [sources: cli, world-trace].
 //!
-//! Parses and checks the trace ([`crate::world_trace`]), runs it on a collision
-//! world ([`crate::world_replay`]) and prints one line per query; with `--check`
-//! also on the brute-force world ([`crate::world_oracle`]), failing at the first
+//! Parses and checks the trace ([`proxima_harness::world_trace`]), runs it on a collision
+//! world ([`proxima_harness::world_replay`]) and prints one line per query; with `--check`
+//! also on the brute-force world ([`proxima_harness::world_oracle`]), failing at the first
 //! answer that differs. Exit codes: 0 success, 1 the world disagrees with the
 //! brute-force world, 2 bad input (file, line, option).
 
-use crate::world_replay::{first_difference, run_oracle, run_world, WorldRun};
-use crate::world_trace::{WorldKind, WorldTrace};
 use proxima::broad::IndexKind;
-use proxima::geom::{Aabb, Sphere};
-use proxima::narrow::{Kdop14, Kdop18, Kdop26, Obb};
 use proxima::world::WorldConfig;
+use proxima_harness::world_replay::{first_difference, run_bv, run_oracle, WorldRun, BVS};
+use proxima_harness::world_trace::{WorldKind, WorldTrace};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -40,27 +38,6 @@ pub struct Args {
     /// Print the total time per operation kind (`#` lines).
     #[arg(long)]
     pub time: bool,
-}
-
-/// The bounding volumes by name.
-pub const BVS: [&str; 6] = ["aabb", "kdop14", "kdop18", "kdop26", "obb", "sphere"];
-
-/// Runs a parsed trace on the world with bounding volume `bv` (one of [`BVS`]).
-pub fn run_bv(
-    bv: &str,
-    trace: &WorldTrace,
-    config: WorldConfig,
-    first: bool,
-) -> Result<WorldRun, (usize, String)> {
-    match bv {
-        "aabb" => run_world::<Aabb>(trace, config, first),
-        "kdop14" => run_world::<Kdop14>(trace, config, first),
-        "kdop18" => run_world::<Kdop18>(trace, config, first),
-        "kdop26" => run_world::<Kdop26>(trace, config, first),
-        "obb" => run_world::<Obb>(trace, config, first),
-        "sphere" => run_world::<Sphere>(trace, config, first),
-        other => Err((0, format!("unknown bounding volume '{other}'"))),
-    }
 }
 
 /// Reads and parses a trace file; the error is the one line to print.
@@ -121,7 +98,7 @@ pub fn main(args: &Args) -> ExitCode {
     }
     if let Some(oracle) = &oracle {
         if let Some(i) = first_difference(&oracle.answers, &run.answers) {
-            let show = |a: Option<&crate::world_replay::WorldAnswer>| {
+            let show = |a: Option<&proxima_harness::world_replay::WorldAnswer>| {
                 a.map_or("nothing".into(), |a| format!("`{a}`"))
             };
             eprintln!(

@@ -5,8 +5,8 @@
 
 use crate::errors::OrRaise;
 use numpy::{PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
-use proxima::geom::Ray;
-use proxima::glam::{Affine3A, Mat3A, Mat4, Vec3, Vec3A};
+use proxima::geom::{Aabb, Frustum, Ray};
+use proxima::glam::{Affine3A, Mat3A, Mat4, Vec3, Vec3A, Vec4};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
@@ -247,10 +247,14 @@ pub fn poses(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<Affine3A>, boo
         .map(|p| (p, single))
 }
 
-/// Rays from `(m, 6)` rows (origin, direction) and `tmax` (a scalar or `(m,)`).
-pub fn rays(rays: &Bound<'_, PyAny>, tmax: &Bound<'_, PyAny>) -> PyResult<Vec<Ray>> {
+/// Rays from `(m, 6)` rows (origin, direction) and `tmax` (a scalar or `(m,)`;
+/// `None`: unbounded).
+pub fn rays(rays: &Bound<'_, PyAny>, tmax: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Ray>> {
     let (v, m) = finite_rows(rays, 6, "rays")?;
-    let t = per_row(tmax, m, "tmax")?;
+    let t = match tmax {
+        Some(t) => per_row(t, m, "tmax")?,
+        None => vec![f32::INFINITY; m],
+    };
     let out: Vec<Ray> = v
         .chunks_exact(6)
         .zip(t)
@@ -260,4 +264,47 @@ pub fn rays(rays: &Bound<'_, PyAny>, tmax: &Bound<'_, PyAny>) -> PyResult<Vec<Ra
         r.validate().or_raise_at(|| format!("rays: row {i}"))?;
     }
     Ok(out)
+}
+
+/// View frusta from `(M, 4, 4)` (or one `(4, 4)`) view-projection matrices,
+/// row-major, acting on column vectors; `depth` is the projection's clip-space
+/// depth range: "zero_to_one" (Direct3D, Vulkan, Metal, wgpu, glam) or
+/// "minus_one_to_one" (OpenGL). Each is checked, naming the first bad one.
+pub fn frusta(matrices: &Bound<'_, PyAny>, depth: &str) -> PyResult<Vec<Frustum>> {
+    // OpenGL's -w <= z <= w becomes 0 <= z' <= w with z' = (z + w) / 2.
+    let to_zero_one = match depth {
+        "zero_to_one" => Mat4::IDENTITY,
+        "minus_one_to_one" => Mat4::from_cols(
+            Vec4::X,
+            Vec4::Y,
+            Vec4::new(0.0, 0.0, 0.5, 0.0),
+            Vec4::new(0.0, 0.0, 0.5, 1.0),
+        ),
+        d => {
+            return Err(PyValueError::new_err(format!(
+                "depth must be \"zero_to_one\" or \"minus_one_to_one\", got {d:?}"
+            )))
+        }
+    };
+    let (ms, _) = matrices4(matrices, "matrices")?;
+    ms.into_iter()
+        .enumerate()
+        .map(|(i, m)| {
+            Frustum::from_view_projection(to_zero_one * m)
+                .or_raise_at(|| format!("matrices: matrix {i}"))
+        })
+        .collect()
+}
+
+/// A box from `(2, 3)` (`[min, max]`) or `(6,)` numbers, finite and not
+/// inverted.
+pub fn aabb(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Aabb> {
+    let (shape, v) = f32_values(obj, what)?;
+    if !matches!(shape[..], [2, 3] | [6]) {
+        return Err(shape_error(what, "(2, 3) or (6,)", &shape));
+    }
+    check_finite(&v, 6, what, "box")?;
+    let b = Aabb::new(vec3(&v[..3]), vec3(&v[3..]));
+    b.validate().or_raise_at(|| what.into())?;
+    Ok(b)
 }

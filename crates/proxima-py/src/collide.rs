@@ -52,6 +52,40 @@ fn run<BV: BoundingVolume>(
     }
 }
 
+/// Row `i` (negative: from the end) of a CSR result: the view
+/// `rows[offsets[i]:offsets[i+1]]`; `IndexError` naming `what` out of range.
+pub fn csr_row<'py>(
+    offsets: &Bound<'py, PyArray1<i64>>,
+    rows: &Bound<'py, PyArray2<i64>>,
+    i: isize,
+    what: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let off = offsets.readonly();
+    let off = off.as_slice()?;
+    let n = off.len() as isize - 1;
+    let k = if i < 0 { i + n } else { i };
+    if !(0..n).contains(&k) {
+        return Err(PyIndexError::new_err(format!(
+            "{what} {i} out of range ({n} {what}s)"
+        )));
+    }
+    let (s, e) = (off[k as usize] as isize, off[k as usize + 1] as isize);
+    rows.get_item(PySlice::new(rows.py(), s, e, 1))
+}
+
+/// A `rotation=` argument: "auto", "refit" or "conservative" (how
+/// axis-aligned volumes follow a rotated pose).
+pub fn rotation_update(name: &str) -> PyResult<RotationUpdate> {
+    match name {
+        "auto" => Ok(RotationUpdate::Auto),
+        "refit" => Ok(RotationUpdate::Refit),
+        "conservative" => Ok(RotationUpdate::Conservative),
+        r => Err(PyValueError::new_err(format!(
+            "rotation must be \"auto\", \"refit\" or \"conservative\", got {r:?}"
+        ))),
+    }
+}
+
 /// The answer of `collide` for N poses (N = 1 for a single pose).
 ///
 /// - `pairs` (K, 2) int64: every intersecting triangle pair (triangle of `a`,
@@ -90,17 +124,7 @@ impl Contacts {
 
     /// The (K_i, 2) triangle pairs of pose `i` (a view of `pairs`).
     fn __getitem__<'py>(&self, py: Python<'py>, i: isize) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.__len__(py) as isize;
-        let k = if i < 0 { i + n } else { i };
-        if !(0..n).contains(&k) {
-            return Err(PyIndexError::new_err(format!(
-                "pose {i} out of range ({n} poses)"
-            )));
-        }
-        let off = self.offsets.bind(py).readonly();
-        let off = off.as_slice()?;
-        let (s, e) = (off[k as usize] as isize, off[k as usize + 1] as isize);
-        self.pairs.bind(py).get_item(PySlice::new(py, s, e, 1))
+        csr_row(self.offsets.bind(py), self.pairs.bind(py), i, "pose")
     }
 
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
@@ -140,16 +164,7 @@ pub fn collide(
     rotation: &str,
     workers: i64,
 ) -> PyResult<Contacts> {
-    let rotation = match rotation {
-        "auto" => RotationUpdate::Auto,
-        "refit" => RotationUpdate::Refit,
-        "conservative" => RotationUpdate::Conservative,
-        r => {
-            return Err(PyValueError::new_err(format!(
-                "rotation must be \"auto\", \"refit\" or \"conservative\", got {r:?}"
-            )))
-        }
-    };
+    let rotation = rotation_update(rotation)?;
     let (poses, _) = arrays::poses(poses, "poses")?;
     for (i, p) in poses.iter().enumerate() {
         check_pose(p).or_raise_at(|| format!("poses: pose {i}"))?;
@@ -162,7 +177,7 @@ pub fn collide(
             macro_rules! pair {
                 ($($v:ident),+) => {
                     match (ma, mb) {
-                        $((AnyMesh::$v(x), AnyMesh::$v(y)) => Some(run(x, y, &poses, first, rotation, &workers)),)+
+                        $((AnyMesh::$v(x), AnyMesh::$v(y)) => Some(run(&**x, &**y, &poses, first, rotation, &workers)),)+
                         _ => None,
                     }
                 };

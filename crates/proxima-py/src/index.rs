@@ -3,14 +3,13 @@
 
 use crate::arrays::{self, finite_rows, int_list, per_row, rows, vec3};
 use crate::errors::OrRaise;
+use crate::ids::Ids;
 use crate::queries::{self, Csr};
 use crate::workers::Workers;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use proxima::broad::{AnyIndex, IndexKind, Query, SceneHint, SpatialIndex};
-use proxima::geom::{Aabb, Frustum, Sphere};
-use proxima::glam::{Mat4, Vec4};
-use proxima::Handle;
-use pyo3::exceptions::{PyKeyError, PyValueError};
+use proxima::geom::{Aabb, Sphere};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 /// A broad-phase index over bounding spheres: one of the six built-in indices,
@@ -28,9 +27,8 @@ use pyo3::prelude::*;
 #[pyclass(module = "proxima", name = "Index")]
 pub struct Index {
     inner: AnyIndex<u64>,
-    /// The handle of each id ever issued; `None` once removed. Ids are dense,
-    /// so this is a vector, 16 bytes per id.
-    handles: Vec<Option<Handle>>,
+    /// The handle of each id ever issued.
+    ids: Ids,
     // issue #14: per-object collision filters (`Filter` group/mask bits) will be
     // stored with the objects once the indices take them (insert(..., group=,
     // mask=) and a `filter=` on every query and on pairs()).
@@ -62,40 +60,22 @@ fn spheres(
     Ok(out)
 }
 
-/// A world box from `(2, 3)` (`[min, max]`) or `(6,)` numbers.
-fn world_box(obj: &Bound<'_, PyAny>) -> PyResult<Aabb> {
-    let (shape, v) = arrays::f32_values(obj, "world")?;
-    if !matches!(shape[..], [2, 3] | [6]) {
-        return Err(arrays::shape_error("world", "(2, 3) or (6,)", &shape));
-    }
-    arrays::check_finite(&v, 6, "world", "box")?;
-    let b = Aabb::new(vec3(&v[..3]), vec3(&v[3..]));
-    b.validate().or_raise_at(|| "world".into())?;
-    Ok(b)
-}
-
 impl Index {
-    /// The handle of a live id; `KeyError` otherwise.
-    fn handle(&self, id: i64) -> PyResult<Handle> {
-        usize::try_from(id)
-            .ok()
-            .and_then(|i| self.handles.get(i).copied().flatten())
-            .ok_or_else(|| PyKeyError::new_err(format!("id {id} is not in the index")))
-    }
-
     /// Stores `spheres` (already checked) under the next ids.
     fn insert_all(&mut self, py: Python<'_>, spheres: Vec<Sphere>) -> PyResult<Vec<i64>> {
-        let first = self.handles.len();
-        let Index { inner, handles } = self;
+        let first = self.ids.issued();
+        let Index { inner, ids } = self;
         py.detach(|| {
-            handles.reserve(spheres.len());
+            ids.reserve(spheres.len());
             for (k, s) in spheres.into_iter().enumerate() {
                 let id = (first + k) as u64;
                 match inner.insert(s, id) {
-                    Ok(h) => handles.push(Some(h)),
+                    Ok(h) => {
+                        ids.push(h);
+                    }
                     Err(e) => {
                         // Only a full index fails here: undo this batch.
-                        for h in handles.drain(first..).flatten() {
+                        for h in ids.take_from(first) {
                             let _ = inner.remove(h);
                         }
                         return Err(e);
@@ -105,7 +85,7 @@ impl Index {
             Ok(())
         })
         .or_raise()?;
-        Ok((first as i64..self.handles.len() as i64).collect())
+        Ok((first as i64..self.ids.issued() as i64).collect())
     }
 
     /// A batch query's answer as `(ids, offsets)`, with `t` if asked.
@@ -165,7 +145,7 @@ impl Index {
         };
         let mut hint = SceneHint::from_spheres(spheres.iter().copied(), spheres.len());
         if let Some(w) = world {
-            hint.world = world_box(w)?;
+            hint.world = arrays::aabb(w, "world")?;
         }
         if let Some(r) = r_max {
             if !(r.is_finite() && r > 0.0) {
@@ -178,7 +158,7 @@ impl Index {
         }
         let mut index = Index {
             inner: kind.build(&hint).or_raise()?,
-            handles: Vec::new(),
+            ids: Ids::new("index"),
         };
         index.insert_all(py, spheres)?;
         Ok(index)
@@ -197,7 +177,7 @@ impl Index {
 
     /// Whether `id` names a stored object.
     fn __contains__(&self, id: &Bound<'_, PyAny>) -> bool {
-        id.extract::<i64>().is_ok_and(|id| self.handle(id).is_ok())
+        id.extract::<i64>().is_ok_and(|id| self.ids.contains(id))
     }
 
     fn __repr__(&self) -> String {
@@ -235,9 +215,9 @@ impl Index {
 
     /// Removes an object. KeyError if `id` is not stored.
     fn remove(&mut self, id: i64) -> PyResult<()> {
-        let h = self.handle(id)?;
+        let h = self.ids.handle(id)?;
         self.inner.remove(h).or_raise()?;
-        self.handles[id as usize] = None;
+        self.ids.forget(id);
         Ok(())
     }
 
@@ -245,18 +225,10 @@ impl Index {
     /// nothing, if one is not stored or appears twice.
     fn remove_many(&mut self, ids: &Bound<'_, PyAny>) -> PyResult<()> {
         let ids = int_list(ids, "ids")?;
-        let mut hs = Vec::with_capacity(ids.len());
-        for &id in &ids {
-            hs.push((id, self.handle(id)?));
-        }
-        let mut sorted: Vec<i64> = ids.clone();
-        sorted.sort_unstable();
-        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
-            return Err(PyKeyError::new_err(format!("id {} appears twice", w[0])));
-        }
-        for (id, h) in hs {
+        let hs = self.ids.handles_of(&ids)?;
+        for (id, h) in ids.into_iter().zip(hs) {
             self.inner.remove(h).or_raise()?;
-            self.handles[id as usize] = None;
+            self.ids.forget(id);
         }
         Ok(())
     }
@@ -302,7 +274,7 @@ impl Index {
         let r = radii.map(|r| per_row(r, n, "radii")).transpose()?;
         let mut moves = Vec::with_capacity(n);
         for (i, (&id, c)) in ids.iter().zip(c.chunks_exact(3)).enumerate() {
-            let h = self.handle(id)?;
+            let h = self.ids.handle(id)?;
             let radius = match &r {
                 Some(r) => r[i],
                 None => self.inner.get(h).or_raise()?.0.radius,
@@ -318,17 +290,13 @@ impl Index {
 
     /// The centre (3,) and radius of one object. KeyError if not stored.
     fn get<'py>(&self, py: Python<'py>, id: i64) -> PyResult<(Bound<'py, PyArray1<f32>>, f32)> {
-        let (s, _) = self.inner.get(self.handle(id)?).or_raise()?;
+        let (s, _) = self.inner.get(self.ids.handle(id)?).or_raise()?;
         Ok((PyArray1::from_slice(py, &s.center.to_array()), s.radius))
     }
 
     /// The ids of the stored objects, ascending.
     fn ids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let ids: Vec<i64> = (self.handles.iter().enumerate())
-            .filter(|(_, h)| h.is_some())
-            .map(|(i, _)| i as i64)
-            .collect();
-        PyArray1::from_vec(py, ids)
+        PyArray1::from_vec(py, self.ids.live())
     }
 
     /// The spheres of `ids` (default: every stored object, by ascending id) as
@@ -346,7 +314,7 @@ impl Index {
         let mut c = Vec::with_capacity(ids.len() * 3);
         let mut r = Vec::with_capacity(ids.len());
         for id in ids {
-            let (s, _) = self.inner.get(self.handle(id)?).or_raise()?;
+            let (s, _) = self.inner.get(self.ids.handle(id)?).or_raise()?;
             c.extend(s.center.to_array());
             r.push(s.radius);
         }
@@ -359,13 +327,13 @@ impl Index {
     /// continue after the last id issued) and releases the memory.
     fn clear(&mut self) {
         self.inner.clear();
-        self.handles.iter_mut().for_each(|h| *h = None);
+        self.ids.forget_all();
     }
 
     /// Bytes held by the index and its id table.
     #[getter]
     fn memory_bytes(&self) -> usize {
-        self.inner.memory_bytes() + self.handles.capacity() * std::mem::size_of::<Option<Handle>>()
+        self.inner.memory_bytes() + self.ids.memory_bytes()
     }
 
     /// Checks the structure's invariants (RuntimeError if one fails: a bug).
@@ -427,8 +395,7 @@ impl Index {
         return_t: bool,
         workers: i64,
     ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
-        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
-        let rs = arrays::rays(rays, tmax.unwrap_or(&inf))?;
+        let rs = arrays::rays(rays, tmax)?;
         let qs: Vec<Query> = rs.into_iter().map(Query::from).collect();
         Ok(Self::csr(py, self.run(py, &qs, workers)?, return_t))
     }
@@ -444,8 +411,7 @@ impl Index {
         tmax: Option<&Bound<'py, PyAny>>,
         workers: i64,
     ) -> PyResult<FirstHits<'py>> {
-        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
-        let rs = arrays::rays(rays, tmax.unwrap_or(&inf))?;
+        let rs = arrays::rays(rays, tmax)?;
         let workers = Workers::new(workers)?;
         let inner = &self.inner;
         let (ids, t) = py.detach(|| queries::first_hits(inner, &rs, &workers));
@@ -468,28 +434,10 @@ impl Index {
         depth: &str,
         workers: i64,
     ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
-        // OpenGL's -w <= z <= w becomes 0 <= z' <= w with z' = (z + w) / 2.
-        let to_zero_one = match depth {
-            "zero_to_one" => Mat4::IDENTITY,
-            "minus_one_to_one" => Mat4::from_cols(
-                Vec4::X,
-                Vec4::Y,
-                Vec4::new(0.0, 0.0, 0.5, 0.0),
-                Vec4::new(0.0, 0.0, 0.5, 1.0),
-            ),
-            d => {
-                return Err(PyValueError::new_err(format!(
-                    "depth must be \"zero_to_one\" or \"minus_one_to_one\", got {d:?}"
-                )))
-            }
-        };
-        let (ms, _) = arrays::matrices4(matrices, "matrices")?;
-        let mut qs = Vec::with_capacity(ms.len());
-        for (i, m) in ms.into_iter().enumerate() {
-            let f = Frustum::from_view_projection(to_zero_one * m)
-                .or_raise_at(|| format!("matrices: matrix {i}"))?;
-            qs.push(Query::from(f));
-        }
+        let qs: Vec<Query> = arrays::frusta(matrices, depth)?
+            .into_iter()
+            .map(Query::from)
+            .collect();
         queries::validate(&qs, "matrices")?;
         Ok(Self::csr(py, self.run(py, &qs, workers)?, false))
     }

@@ -8,6 +8,10 @@
 //!   arrays or a file; batch ray casts with Open3D's result names.
 //! - [`collide::collide`]: mesh–mesh collision for one pose or a batch, with the
 //!   cost counters ([`collide::Contacts`]).
+//! - [`world::World`]: the collision world — shared meshes and balls at rigid
+//!   poses, filters, ignored pairs, contacts ([`world::WorldContacts`]), ray
+//!   casts, sphere queries, culling — with objects named by integer ids
+//!   ([`ids`]).
 //!
 //! Every array argument is converted in [`arrays`] (any real dtype, lists,
 //! non-contiguous views; wrong shapes and NaN raise `ValueError`); library
@@ -16,19 +20,20 @@
 //! `workers` threads ([`workers`]).
 //!
 //! Still to come, each with a marked place: k nearest neighbours, sphere
-//! sweeps and collision filters on `Index` (issue #14, in `index.rs`); the
-//! collision world `World` (issue #13, registered below); mesh distance
-//! queries (issue #15, in `collide.rs`).
+//! sweeps and collision filters on `Index` (issue #14, in `index.rs`); mesh
+//! distance queries (issue #15, in `collide.rs`).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod arrays;
 pub mod collide;
 pub mod errors;
+pub mod ids;
 pub mod index;
 pub mod mesh;
 pub mod queries;
 pub mod workers;
+pub mod world;
 
 use pyo3::prelude::*;
 
@@ -44,8 +49,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         proxima::broad::IndexKind::ALL.map(|k| k.name()).to_vec(),
     )?;
     m.add("BOUNDING_VOLUMES", mesh::BV_NAMES.to_vec())?;
-    // issue #13: the collision world (`World(index=...)`, add, set_poses,
-    // ignore, contacts, ray_cast) is registered here once `proxima::world`
-    // lands.
+    m.add_class::<world::World>()?;
+    m.add_class::<world::WorldContacts>()?;
     Ok(())
 }

@@ -15,21 +15,23 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
+use std::sync::Arc;
 
-/// A mesh with whichever bounding volume was chosen at run time.
+/// A mesh with whichever bounding volume was chosen at run time, in an `Arc`
+/// so that `World` objects share it (its trees are built once).
 pub enum AnyMesh {
     /// With an AABB tree.
-    Aabb(RsMesh<Aabb>),
+    Aabb(Arc<RsMesh<Aabb>>),
     /// With a k-DOP-14 tree.
-    Kdop14(RsMesh<Kdop14>),
+    Kdop14(Arc<RsMesh<Kdop14>>),
     /// With a k-DOP-18 tree.
-    Kdop18(RsMesh<Kdop18>),
+    Kdop18(Arc<RsMesh<Kdop18>>),
     /// With a k-DOP-26 tree.
-    Kdop26(RsMesh<Kdop26>),
+    Kdop26(Arc<RsMesh<Kdop26>>),
     /// With an OBB tree.
-    Obb(RsMesh<Obb>),
+    Obb(Arc<RsMesh<Obb>>),
     /// With a sphere tree.
-    Sphere(RsMesh<Sphere>),
+    Sphere(Arc<RsMesh<Sphere>>),
 }
 
 /// `$body` with `$m` bound to the mesh inside `$any`, whatever its volume.
@@ -53,12 +55,12 @@ impl AnyMesh {
     /// Builds the collision tree of `geometry` with bounding volume `bv`.
     fn build(geometry: TriMesh, bv: &str, options: BuildOptions) -> proxima::Result<AnyMesh> {
         Ok(match bv {
-            "aabb" => AnyMesh::Aabb(RsMesh::from_trimesh(geometry, options)?),
-            "kdop14" => AnyMesh::Kdop14(RsMesh::from_trimesh(geometry, options)?),
-            "kdop18" => AnyMesh::Kdop18(RsMesh::from_trimesh(geometry, options)?),
-            "kdop26" => AnyMesh::Kdop26(RsMesh::from_trimesh(geometry, options)?),
-            "obb" => AnyMesh::Obb(RsMesh::from_trimesh(geometry, options)?),
-            "sphere" => AnyMesh::Sphere(RsMesh::from_trimesh(geometry, options)?),
+            "aabb" => AnyMesh::Aabb(Arc::new(RsMesh::from_trimesh(geometry, options)?)),
+            "kdop14" => AnyMesh::Kdop14(Arc::new(RsMesh::from_trimesh(geometry, options)?)),
+            "kdop18" => AnyMesh::Kdop18(Arc::new(RsMesh::from_trimesh(geometry, options)?)),
+            "kdop26" => AnyMesh::Kdop26(Arc::new(RsMesh::from_trimesh(geometry, options)?)),
+            "obb" => AnyMesh::Obb(Arc::new(RsMesh::from_trimesh(geometry, options)?)),
+            "sphere" => AnyMesh::Sphere(Arc::new(RsMesh::from_trimesh(geometry, options)?)),
             _ => unreachable!("checked by bv_name"),
         })
     }
@@ -68,7 +70,7 @@ impl AnyMesh {
         fn name<BV: BoundingVolume>(_: &RsMesh<BV>) -> &'static str {
             BV::NAME
         }
-        each_mesh!(self, m => name(m))
+        each_mesh!(self, m => name(&**m))
     }
 
     fn trimesh(&self) -> &TriMesh {
@@ -243,13 +245,22 @@ impl Mesh {
 
     /// Moves the vertices (same count, same faces: a deformed mesh) and
     /// refits both trees, O(V + F). ValueError, changing nothing, on a wrong
-    /// count or a non-finite vertex.
+    /// count or a non-finite vertex, or while the mesh is the shape of objects
+    /// of a `World` (a world's shapes never change under it).
     fn set_vertices(&mut self, py: Python<'_>, vertices: &Bound<'_, PyAny>) -> PyResult<()> {
         let (v, _) = finite_rows(vertices, 3, "vertices")?;
         let v: Vec<Vec3> = v.chunks_exact(3).map(vec3).collect();
         let inner = &mut self.inner;
-        py.detach(|| each_mesh!(inner, m => m.set_vertices(&v)))
-            .or_raise()
+        py.detach(|| {
+            each_mesh!(inner, m => match Arc::get_mut(m) {
+                Some(m) => m.set_vertices(&v),
+                None => Err(proxima::Error::InvalidParameter(format!(
+                    "the mesh is the shape of {} World object(s); remove them first, or build a new Mesh",
+                    Arc::strong_count(m) - 1
+                ))),
+            })
+        })
+        .or_raise()
     }
 
     fn __repr__(&self) -> String {
@@ -282,8 +293,7 @@ impl Mesh {
         pose: Option<&Bound<'py, PyAny>>,
         workers: i64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
-        let mut rs = arrays::rays(rays, tmax.unwrap_or(&inf))?;
+        let mut rs = arrays::rays(rays, tmax)?;
         if let Some(p) = pose {
             let (p, single) = arrays::poses(p, "pose")?;
             if !single {
@@ -302,7 +312,7 @@ impl Mesh {
         let workers = Workers::new(workers)?;
         let inner = &self.inner;
         let hits = py
-            .detach(|| each_mesh!(inner, m => cast(m, &rs, &workers)))
+            .detach(|| each_mesh!(inner, m => cast(&**m, &rs, &workers)))
             .or_raise()?;
         let n = hits.len();
         let mut t = Vec::with_capacity(n);

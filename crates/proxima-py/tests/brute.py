@@ -228,3 +228,151 @@ def poses(rotations, translations) -> np.ndarray:
 def csr_lists(ids, offsets):
     """CSR (ids, offsets) as a list of arrays."""
     return [ids[offsets[i] : offsets[i + 1]] for i in range(len(offsets) - 1)]
+
+
+def point_triangle_distance(p, tris) -> np.ndarray:
+    """Distance from the point p (3,) to each closed triangle of tris (F, 3, 3),
+    float64: the plane distance when p projects inside, else the nearest edge."""
+    p = np.asarray(p, dtype=np.float64)
+    a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
+    n = np.cross(b - a, c - a)
+    nn = (n * n).sum(1)
+    s = ((p - a) * n).sum(1) / nn
+    q = p - s[:, None] * n
+    side = lambda u, v: (np.cross(v - u, q - u) * n).sum(1) >= 0
+    inside = side(a, b) & side(b, c) & side(c, a)
+
+    def segment(u, v):
+        e = v - u
+        t = np.clip(((p - u) * e).sum(1) / (e * e).sum(1), 0.0, 1.0)
+        return np.linalg.norm(p - (u + t[:, None] * e), axis=1)
+
+    edges = np.minimum(np.minimum(segment(a, b), segment(b, c)), segment(c, a))
+    return np.where(inside, np.abs(s) * np.sqrt(nn), edges)
+
+
+class BruteWorld:
+    """The collision world from scratch: every object pair, every primitive
+    pair, in float64 on the float32 values the library stores, with the cases
+    too close to call (within a band) reported beside the answers.
+
+    Objects: id -> (mesh (vertices, faces) or ball radius, (4, 4) pose,
+    group, mask). Meshes are surfaces, balls solid; a ball's centre is its
+    pose's translation."""
+
+    def __init__(self):
+        self.objects = {}
+        self.ignored = set()
+
+    def add(self, i, shape, pose, group=0xFFFFFFFF, mask=0xFFFFFFFF):
+        self.objects[i] = [shape, f32(pose), group, mask]
+
+    def remove(self, i):
+        del self.objects[i]
+        self.ignored = {p for p in self.ignored if i not in p}
+
+    def interacts(self, i, j):
+        _, _, ga, ma = self.objects[i]
+        _, _, gb, mb = self.objects[j]
+        return (ga & mb) != 0 and (gb & ma) != 0
+
+    @staticmethod
+    def passes(o, group, mask):
+        return (o[2] & mask) != 0 and (group & o[3]) != 0
+
+    def world_triangles(self, i):
+        shape, pose, _, _ = self.objects[i]
+        v, f = shape
+        return transform(pose, v)[f]
+
+    def bound(self, i):
+        """A ball around the posed shape: (centre, radius)."""
+        shape, pose, _, _ = self.objects[i]
+        if isinstance(shape, float):
+            return pose[:3, 3], shape
+        v = f32(shape[0])
+        c = (v.min(0) + v.max(0)) / 2
+        return pose[:3, :3] @ c + pose[:3, 3], np.linalg.norm(v - c, axis=1).max()
+
+    def pair(self, i, j, band=1e-5):
+        """(certain, unsure) sets of primitive pairs (of i, of j)."""
+        si, pi = self.objects[i][:2]
+        sj, pj = self.objects[j][:2]
+        ball_i, ball_j = isinstance(si, float), isinstance(sj, float)
+        if ball_i and ball_j:
+            d = np.linalg.norm(pi[:3, 3] - pj[:3, 3]) - (si + sj)
+            scale = 1 + np.abs(pi[:3, 3]).max() + np.abs(pj[:3, 3]).max()
+            return ({(0, 0)} if d < -band * scale else set()), (
+                {(0, 0)} if abs(d) <= band * scale else set()
+            )
+        if ball_i or ball_j:
+            ball, mesh = (i, j) if ball_i else (j, i)
+            r = self.objects[ball][0]
+            centre = self.objects[ball][1][:3, 3]
+            tris = self.world_triangles(mesh)
+            d = point_triangle_distance(centre, tris) - r
+            scale = 1 + np.abs(tris).max() + r
+            sure = np.nonzero(d < -band * scale)[0]
+            near = np.nonzero(np.abs(d) <= band * scale)[0]
+            key = (lambda t: (0, int(t))) if ball_i else (lambda t: (int(t), 0))
+            return {key(t) for t in sure}, {key(t) for t in near}
+        # Mesh i moved into mesh j's frame.
+        rel = np.linalg.inv(pj.astype(np.float64)) @ pi
+        return mesh_pairs(si[0], si[1], sj[0], sj[1], rel, band=band)
+
+    def contacts(self):
+        """{(i, j): (certain, unsure)} over pairs i < j that may touch."""
+        ids = sorted(self.objects)
+        out = {}
+        for k, i in enumerate(ids):
+            ci, ri = self.bound(i)
+            for j in ids[k + 1 :]:
+                if (i, j) in self.ignored or not self.interacts(i, j):
+                    continue
+                cj, rj = self.bound(j)
+                if np.linalg.norm(ci - cj) > (ri + rj) * 1.01 + 1e-3:
+                    continue
+                sure, unsure = self.pair(i, j)
+                if sure or unsure:
+                    out[(i, j)] = (sure, unsure)
+        return out
+
+    def near(self, q, group=0xFFFFFFFF, mask=0xFFFFFFFF, band=1e-5):
+        """(certain, unsure) ids with a point within q[3] of q[:3]."""
+        q = f32(q)
+        sure, unsure = set(), set()
+        for i, o in self.objects.items():
+            if not self.passes(o, group, mask):
+                continue
+            shape, pose = o[:2]
+            if isinstance(shape, float):
+                d = np.linalg.norm(q[:3] - pose[:3, 3]) - (shape + q[3])
+                scale = 1 + np.abs(pose[:3, 3]).max() + shape
+            else:
+                tris = self.world_triangles(i)
+                d = point_triangle_distance(q[:3], tris).min() - q[3]
+                scale = 1 + np.abs(tris).max()
+            scale += np.abs(q).max()
+            if d < -band * scale:
+                sure.add(i)
+            elif abs(d) <= band * scale:
+                unsure.add(i)
+        return sure, unsure
+
+    def ray(self, ray, tmax=np.inf, group=0xFFFFFFFF, mask=0xFFFFFFFF):
+        """Per object hit: {id: (t, triangle, unsure)}."""
+        out = {}
+        for i, o in self.objects.items():
+            if not self.passes(o, group, mask):
+                continue
+            shape, pose = o[:2]
+            if isinstance(shape, float):
+                rows, t = ray_query(pose[None, :3, 3], [shape], ray, tmax)
+                if len(rows):
+                    out[i] = (t[0], 0, False)
+            else:
+                v = transform(pose, shape[0])
+                t, tri, unsure, _ = ray_mesh(v, shape[1], np.asarray(ray)[None], tmax)
+                if np.isfinite(t[0]) or unsure[0]:
+                    out[i] = (t[0], int(tri[0]), bool(unsure[0]))
+        return out

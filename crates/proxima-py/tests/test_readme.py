@@ -28,3 +28,4 @@ def test_readme_example_runs(data):
     # What the example computed is what it says.
     assert scope["pairs"].shape[1] == 2 and len(scope["pairs"]) > 100
     assert scope["contacts"].colliding.tolist() == [True, True, False]
+    assert scope["world"].n_ignored == 1 and len(scope["world"]) == 3

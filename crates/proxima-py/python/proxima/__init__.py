@@ -9,8 +9,12 @@
   ``t_hit`` / ``primitive_ids`` / ``primitive_uvs``.
 - :func:`collide` -- exact mesh-mesh collision for one pose or a batch of
   poses, returning :class:`Contacts` (triangle pairs and cost counters).
+- :class:`World` -- the collision world: shared meshes and balls at rigid
+  poses with filter bits and ignored pairs; :meth:`World.contacts` (object
+  pairs and their triangle pairs, :class:`WorldContacts`), ray casts, sphere
+  queries, culling.
 
-Bad input raises ``ValueError`` (``KeyError`` for an id not in an index,
+Bad input raises ``ValueError`` (``KeyError`` for an id not in an index or world,
 ``FileNotFoundError`` / ``OSError`` for unreadable files) with the library's
 message. Long calls release the GIL; batch calls take ``workers=`` (1: this
 thread, n: a pool of n threads, -1: one per core).
@@ -18,7 +22,16 @@ thread, n: a pool of n threads, -1: one per core).
 
 from importlib.metadata import PackageNotFoundError, version
 
-from ._native import BOUNDING_VOLUMES, INDEX_KINDS, Contacts, Index, Mesh, collide
+from ._native import (
+    BOUNDING_VOLUMES,
+    INDEX_KINDS,
+    Contacts,
+    Index,
+    Mesh,
+    World,
+    WorldContacts,
+    collide,
+)
 
 try:
     __version__ = version("proxima")
@@ -31,5 +44,7 @@ __all__ = [
     "Contacts",
     "Index",
     "Mesh",
+    "World",
+    "WorldContacts",
     "collide",
 ]

@@ -246,7 +246,8 @@ class Mesh:
 
     def set_vertices(self, vertices: ArrayLike) -> None:
         """Moves the vertices (same count and faces) and refits both trees.
-        ValueError, changing nothing, on a wrong count or a non-finite vertex."""
+        ValueError, changing nothing, on a wrong count or a non-finite vertex,
+        or while the mesh is the shape of objects of a :class:`World`."""
 
     def cast_rays(
         self,
@@ -308,3 +309,214 @@ def collide(
     (naming it), or meshes with different bounding volumes; all poses are
     checked before any work. Releases the GIL.
     """
+
+class WorldRayCastResult(TypedDict):
+    """The answer of :meth:`World.ray_cast` (Open3D's names)."""
+
+    t_hit: NDArray[np.float32]
+    """(R,) hit parameter, inf for a miss."""
+    geometry_ids: NDArray[np.int64]
+    """(R,) the object hit (its id), -1 for a miss."""
+    primitive_ids: NDArray[np.int64]
+    """(R,) the triangle hit (0 for a ball), -1 for a miss."""
+
+class WorldCounters(TypedDict):
+    """What one :meth:`World.contacts` query did."""
+
+    broad_pairs: int
+    """Candidate object pairs from the broad phase."""
+    filtered: int
+    """Candidates dropped by the filters or as ignored pairs."""
+    narrow_pairs: int
+    """Pairs the narrow phase tested."""
+    coherent_pairs: int
+    """Pairs of unchanged objects whose last answer was reused."""
+    cut_starts: int
+    """Tests that started from the pair's last traversal cut."""
+    nv: int
+    """Bounding-volume pair tests."""
+    np: int
+    """Primitive pair tests."""
+    nu: int
+    """Bounding-volume updates."""
+
+class WorldContacts:
+    """The answer of :meth:`World.contacts`: P object pairs in contact.
+    ``len(contacts)`` is P, ``contacts[i]`` the (K_i, 2) primitive pairs of
+    pair i, ``bool(contacts)`` whether any pair touches."""
+
+    @property
+    def pairs(self) -> NDArray[np.int64]:
+        """(P, 2) object ids (a, b), a < b, rows sorted."""
+
+    @property
+    def offsets(self) -> NDArray[np.int64]:
+        """(P + 1,): pair i's primitive pairs are
+        ``triangles[offsets[i]:offsets[i+1]]``."""
+
+    @property
+    def triangles(self) -> NDArray[np.int64]:
+        """(K, 2) primitive pairs (triangle of a, triangle of b; 0 for a
+        ball), ascending within each pair; one per pair with ``first=True``."""
+
+    @property
+    def counters(self) -> WorldCounters:
+        """What the query did."""
+
+    def __len__(self) -> int: ...
+    def __bool__(self) -> bool: ...
+    def __getitem__(self, i: int) -> NDArray[np.int64]: ...
+
+class World:
+    """A collision world: objects, each a shape -- a shared :class:`Mesh` or a
+    solid ball -- at a rigid pose with collision filter bits, in a broad-phase
+    index, with exact mesh-mesh, mesh-ball and ball-ball tests.
+
+    Objects are named by integer **ids**: insertion order, never reused
+    (a removed id raises ``KeyError``). Poses are (4, 4) or (3, 4) row-major
+    ``[R | t]`` rigid motions (|RᵀR - I| <= 1e-3, det > 0, finite); anything
+    else raises ``ValueError`` and changes nothing. Two objects are tested only
+    if ``group_a & mask_b`` and ``group_b & mask_a`` are both non-zero and the
+    pair is not ignored. Meshes are surfaces (a mesh wholly inside another
+    does not touch it); balls are solid. ``workers``: 1 (this thread), n (a
+    pool of n threads) or -1 (one per core).
+    """
+
+    def __init__(
+        self,
+        *,
+        index: IndexKind | None = None,
+        bv: BoundingVolume = "kdop18",
+        bounds: ArrayLike | None = None,
+        coherence: bool = True,
+        rotation: Literal["auto", "refit", "conservative"] = "auto",
+    ) -> None:
+        """An empty world. ``index``: the broad-phase kind (None: "loose-kd").
+        ``bv``: the bounding volume of the meshes it takes. ``bounds`` ([min,
+        max], (2, 3) or (6,)): where the objects will be (None: the index is
+        built at the first query and rebuilt when the scene drifts).
+        ``coherence``: skip pairs unchanged since the last contacts (same
+        answers). ValueError on an unknown name or a bad box."""
+
+    @property
+    def index(self) -> str:
+        """The broad-phase index kind."""
+
+    @property
+    def bv(self) -> str:
+        """The bounding volume of the world's meshes."""
+
+    @property
+    def n_ignored(self) -> int:
+        """Number of ignored pairs."""
+
+    @property
+    def memory_bytes(self) -> int:
+        """Heap bytes of the world's own structures (shared meshes not counted)."""
+
+    def __len__(self) -> int: ...
+    def __contains__(self, id: object) -> bool: ...
+    def ids(self) -> NDArray[np.int64]:
+        """The ids of the objects, ascending."""
+
+    def add(
+        self,
+        shape: Mesh | float,
+        pose: ArrayLike | None = None,
+        *,
+        group: int = 0xFFFFFFFF,
+        mask: int = 0xFFFFFFFF,
+    ) -> int:
+        """Adds an object and returns its id. ``shape``: a :class:`Mesh`
+        (shared, not copied) or a ball radius. ``pose``: None (identity),
+        (4, 4) or (3, 4). ValueError, adding nothing, on a bad pose or radius,
+        or a mesh whose bv is not the world's; TypeError on another shape."""
+
+    def add_many(
+        self,
+        shape: Mesh | float,
+        poses: ArrayLike,
+        *,
+        group: int = 0xFFFFFFFF,
+        mask: int = 0xFFFFFFFF,
+    ) -> NDArray[np.int64]:
+        """One object per pose of ``poses`` ((N, 4, 4) or (N, 3, 4)), all
+        sharing ``shape``; returns their ids (N,). All or nothing."""
+
+    def remove(self, id: int) -> None:
+        """Removes an object and its ignored pairs. KeyError if absent."""
+
+    def remove_many(self, ids: ArrayLike) -> None:
+        """Removes every object of ``ids``. All or nothing: KeyError if one is
+        absent or appears twice."""
+
+    def set_pose(self, id: int, pose: ArrayLike) -> None:
+        """Moves one object. KeyError / ValueError, changing nothing."""
+
+    def set_poses(self, ids: ArrayLike, poses: ArrayLike) -> None:
+        """Moves objects ``ids`` (N,) to ``poses`` ((N, 4, 4) or (N, 3, 4));
+        an id listed twice takes its last pose. All or nothing."""
+
+    def pose(self, id: int) -> NDArray[np.float32]:
+        """An object's pose, (4, 4)."""
+
+    def set_filter(self, id: int, *, group: int, mask: int) -> None:
+        """Sets an object's filter bits (each in 0..2**32)."""
+
+    def filter(self, id: int) -> tuple[int, int]:
+        """An object's filter as (group, mask)."""
+
+    def ignore(self, a: int, b: int) -> None:
+        """Never report the pair (a, b) in contacts (an allowed-collision
+        matrix entry). KeyError for an absent id; ValueError for a == b."""
+
+    def unignore(self, a: int, b: int) -> bool:
+        """Reports (a, b) again; returns whether it was ignored."""
+
+    def is_ignored(self, a: int, b: int) -> bool:
+        """Whether the pair (a, b) is ignored."""
+
+    def contacts(self, *, first: bool = False, workers: int = 1) -> WorldContacts:
+        """Every pair of objects whose posed shapes share a point (touching
+        counts), each once, after filters and ignored pairs, with all its
+        intersecting primitive pairs (one witness with ``first=True``).
+        Releases the GIL."""
+
+    def ray_cast(
+        self,
+        rays: ArrayLike,
+        tmax: ArrayLike | float | None = None,
+        *,
+        group: int = 0xFFFFFFFF,
+        mask: int = 0xFFFFFFFF,
+        workers: int = 1,
+    ) -> WorldRayCastResult:
+        """The first primitive each ray ((R, 6): origin, direction) hits for
+        t in [0, tmax], among objects whose filter meets (group, mask):
+        smallest t, ties to the smaller id, then triangle. Balls are solid."""
+
+    def overlap_sphere(
+        self,
+        spheres: ArrayLike,
+        *,
+        group: int = 0xFFFFFFFF,
+        mask: int = 0xFFFFFFFF,
+        workers: int = 1,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """Objects with some point within r of each query ((M, 4): x, y, z,
+        r), exactly: ``(ids, offsets)``, each query's ids ascending."""
+
+    def cull(
+        self,
+        matrices: ArrayLike,
+        *,
+        depth: Literal["zero_to_one", "minus_one_to_one"] = "zero_to_one",
+        group: int = 0xFFFFFFFF,
+        mask: int = 0xFFFFFFFF,
+        workers: int = 1,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """Objects whose bounding sphere is not entirely outside each view
+        frustum ((M, 4, 4) view-projection matrices): ``(ids, offsets)``."""
+
+    def validate(self) -> None:
+        """Checks the invariants (RuntimeError if one fails: a bug)."""

@@ -19,15 +19,36 @@ use std::sync::Arc;
 #[derive(Clone, Debug, PartialEq)]
 pub enum WorldOp {
     /// `mesh NAME FILE`: build the mesh's trees.
-    Mesh { mesh: u32 },
+    Mesh {
+        /// Index into [`WorldTrace::meshes`].
+        mesh: u32,
+    },
     /// `add ID NAME`: a new object at the identity pose.
-    Add { slot: u32, mesh: u32 },
+    Add {
+        /// The object's slot.
+        slot: u32,
+        /// Index into [`WorldTrace::meshes`].
+        mesh: u32,
+    },
     /// `pose ID r00 … tz`.
-    Pose { slot: u32, pose: Affine3A },
+    Pose {
+        /// The object's slot.
+        slot: u32,
+        /// The new rigid pose.
+        pose: Affine3A,
+    },
     /// `remove ID`.
-    Remove { slot: u32 },
+    Remove {
+        /// The object's slot.
+        slot: u32,
+    },
     /// `ignore ID1 ID2`.
-    Ignore { a: u32, b: u32 },
+    Ignore {
+        /// One object's slot.
+        a: u32,
+        /// The other object's slot.
+        b: u32,
+    },
     /// `contacts`.
     Contacts,
     /// `ray OX OY OZ DX DY DZ TMAX`.
@@ -39,13 +60,21 @@ pub enum WorldOp {
 /// Operation kinds, for timing tables (`kind as usize` indexes [`WorldKind::ALL`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WorldKind {
+    /// `mesh` lines.
     Mesh,
+    /// `add` lines.
     Add,
+    /// `pose` lines.
     Pose,
+    /// `remove` lines.
     Remove,
+    /// `ignore` lines.
     Ignore,
+    /// `contacts` lines.
     Contacts,
+    /// `ray` lines.
     Ray,
+    /// `sphere` lines.
     Sphere,
 }
 

@@ -4,8 +4,9 @@
 use crate::world_oracle::BruteWorld;
 use crate::world_trace::{WorldOp, WorldTrace};
 use proxima::broad::Filter;
+use proxima::geom::{Aabb, Sphere};
 use proxima::glam::Affine3A;
-use proxima::narrow::{BoundingVolume, BuildOptions, Mesh};
+use proxima::narrow::{BoundingVolume, BuildOptions, Kdop14, Kdop18, Kdop26, Mesh, Obb};
 use proxima::world::{ContactMode, ContactReport, Shape, World, WorldConfig};
 use proxima::Handle;
 use std::fmt;
@@ -189,6 +190,27 @@ pub fn first_difference(reference: &[WorldAnswer], other: &[WorldAnswer]) -> Opt
     (0..n)
         .find(|&i| reference[i] != other[i])
         .or((reference.len() != other.len()).then_some(n))
+}
+
+/// The bounding volumes by name.
+pub const BVS: [&str; 6] = ["aabb", "kdop14", "kdop18", "kdop26", "obb", "sphere"];
+
+/// Runs a parsed trace on the world with bounding volume `bv` (one of [`BVS`]).
+pub fn run_bv(
+    bv: &str,
+    trace: &WorldTrace,
+    config: WorldConfig,
+    first: bool,
+) -> Result<WorldRun, (usize, String)> {
+    match bv {
+        "aabb" => run_world::<Aabb>(trace, config, first),
+        "kdop14" => run_world::<Kdop14>(trace, config, first),
+        "kdop18" => run_world::<Kdop18>(trace, config, first),
+        "kdop26" => run_world::<Kdop26>(trace, config, first),
+        "obb" => run_world::<Obb>(trace, config, first),
+        "sphere" => run_world::<Sphere>(trace, config, first),
+        other => Err((0, format!("unknown bounding volume '{other}'"))),
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,102 @@
+//! Integer ids for the objects of an `Index` or a `World`: insertion order,
+//! never reused, each mapped to the library's generational handle.
+
+use proxima::Handle;
+use pyo3::exceptions::PyKeyError;
+use pyo3::PyResult;
+
+/// The handle of each id ever issued (`None` once removed). Ids are dense, so
+/// this is a vector, 16 bytes per id.
+pub struct Ids {
+    handles: Vec<Option<Handle>>,
+    /// What holds the objects, for messages ("index", "world").
+    holder: &'static str,
+}
+
+impl Ids {
+    /// No id issued yet; `holder` names the container in `KeyError` messages.
+    pub fn new(holder: &'static str) -> Ids {
+        Ids {
+            handles: Vec::new(),
+            holder,
+        }
+    }
+
+    /// The handle of a live id; `KeyError` otherwise. O(1).
+    pub fn handle(&self, id: i64) -> PyResult<Handle> {
+        usize::try_from(id)
+            .ok()
+            .and_then(|i| self.handles.get(i).copied().flatten())
+            .ok_or_else(|| PyKeyError::new_err(format!("id {id} is not in the {}", self.holder)))
+    }
+
+    /// Whether `id` is live.
+    pub fn contains(&self, id: i64) -> bool {
+        self.handle(id).is_ok()
+    }
+
+    /// The number of ids ever issued: the next id.
+    pub fn issued(&self) -> usize {
+        self.handles.len()
+    }
+
+    /// Issues the next id, for `h`.
+    pub fn push(&mut self, h: Handle) -> i64 {
+        self.handles.push(Some(h));
+        (self.handles.len() - 1) as i64
+    }
+
+    /// Room for `n` more ids.
+    pub fn reserve(&mut self, n: usize) {
+        self.handles.reserve(n);
+    }
+
+    /// Takes back the ids issued from `first` on (undoing a failed batch) and
+    /// returns their handles.
+    pub fn take_from(&mut self, first: usize) -> Vec<Handle> {
+        self.handles.drain(first..).flatten().collect()
+    }
+
+    /// Marks a live id removed.
+    pub fn forget(&mut self, id: i64) {
+        if let Some(h) = usize::try_from(id)
+            .ok()
+            .and_then(|i| self.handles.get_mut(i))
+        {
+            *h = None;
+        }
+    }
+
+    /// Marks every id removed (new ids continue after the last one issued).
+    pub fn forget_all(&mut self) {
+        self.handles.iter_mut().for_each(|h| *h = None);
+    }
+
+    /// The live ids, ascending.
+    pub fn live(&self) -> Vec<i64> {
+        (self.handles.iter().enumerate())
+            .filter(|(_, h)| h.is_some())
+            .map(|(i, _)| i as i64)
+            .collect()
+    }
+
+    /// The handles of `ids`, every one live and none twice; `KeyError` naming
+    /// the first that is not.
+    pub fn handles_of(&self, ids: &[i64]) -> PyResult<Vec<Handle>> {
+        let hs = ids
+            .iter()
+            .map(|&id| self.handle(id))
+            .collect::<PyResult<Vec<_>>>()?;
+        let mut sorted = ids.to_vec();
+        sorted.sort_unstable();
+        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+            return Err(PyKeyError::new_err(format!("id {} appears twice", w[0])));
+        }
+        Ok(hs)
+    }
+
+    /// Heap bytes of the table.
+    pub fn memory_bytes(&self) -> usize {
+        self.handles.capacity() * std::mem::size_of::<Option<Handle>>()
+    }
+}

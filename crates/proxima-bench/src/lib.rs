@@ -12,6 +12,7 @@
 //! - [`parry`]: the parry3d BVH adapter;
 //! - [`registry`]: the list of structures (every `IndexKind`, then the peers);
 //! - [`w5`]: the mesh-vs-mesh workload W5 and its peer [`parry_mesh`];
+//! - [`w5_distance`]: W5's poses through the distance queries (issue #15);
 //! - [`w6`]: rays vs one mesh (its own runner, table and agreement check), with
 //!   its peers (obvhs, bvh, parry3d's `TriMesh`) beside it, as W4's are;
 //! - [`world`]: the collision world's scenes (tumble, arms, deep
@@ -33,5 +34,6 @@ pub mod run;
 pub mod structure;
 pub mod w4;
 pub mod w5;
+pub mod w5_distance;
 pub mod w6;
 pub mod world;

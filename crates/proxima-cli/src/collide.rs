@@ -1,16 +1,21 @@
-//! `proxima collide A B [options]`: mesh-vs-mesh contacts with the cost
-//! counters [sources: bvh-cost, pose-format].
+//! `proxima collide A B [options]`: mesh-vs-mesh contacts, distances or
+//! proximity tests with the cost counters [sources: bvh-cost, pose-format].
 //!
 //! ```text
 //! proxima collide A B [--bv aabb|kdop14|kdop18|kdop26|obb|sphere]
 //!                     [--split mean|median|sah] [--leaf N]
-//!                     [--rotation auto|refit|conservative] [--first]
+//!                     [--rotation auto|refit|conservative]
+//!                     [--first | --distance | --within D]
 //!                     [--poses FILE] [--stats] [--time]
 //! ```
 //! Each pose (12 numbers per line: a row-major rotation, then a translation; `#`
 //! comments and blank lines are skipped) moves the first mesh; the second stays at
 //! the identity. Without `--poses`, one identity pose. Prints one line per pose:
 //! `pairs N` (distinct intersecting triangle pairs) or, with `--first`, `hit 0|1`;
+//! with `--distance`, `distance D I J` (the meshes' distance, `0` if they
+//! intersect, with 9 significant digits, and a nearest pair of triangles, I of A
+//! and J of B: `Proximity::distance`); with `--within D`, `within 0|1` (whether
+//! that distance is at most `D`: `Proximity::within`, with an early exit);
 //! `--stats` appends `nv NV np NP nu NU`. `--time` prints the mean time per query on
 //! stderr (loading and BVH builds excluded). Bad input: one line naming the file
 //! (and line), exit code 2.
@@ -19,15 +24,28 @@ use proxima::geom::{Aabb, Sphere};
 use proxima::glam::Affine3A;
 use proxima::narrow::{
     BoundingVolume, BuildOptions, Collider, CostCounters, Kdop14, Kdop18, Kdop26, Mesh, Obb,
-    RotationUpdate, SplitRule, TriMesh,
+    Proximity, RotationUpdate, SplitRule, TriMesh,
 };
 use proxima_harness::poses;
 use std::fmt::Write as _;
 use std::time::Instant;
 
 const USAGE: &str = "usage: proxima collide A B [--bv aabb|kdop14|kdop18|kdop26|obb|sphere] \
-[--split mean|median|sah] [--leaf N] [--rotation auto|refit|conservative] [--first] \
-[--poses FILE] [--stats] [--time]";
+[--split mean|median|sah] [--leaf N] [--rotation auto|refit|conservative] \
+[--first | --distance | --within D] [--poses FILE] [--stats] [--time]";
+
+/// What each pose asks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Query {
+    /// Every intersecting triangle pair (`pairs N`).
+    Pairs,
+    /// Whether any pair intersects (`hit 0|1`).
+    First,
+    /// The distance and a nearest triangle pair (`distance D I J`).
+    Distance,
+    /// Whether the distance is at most the margin (`within 0|1`).
+    Within(f64),
+}
 
 /// Parsed command line.
 struct Args {
@@ -36,7 +54,7 @@ struct Args {
     bv: String,
     build: BuildOptions,
     rotation: RotationUpdate,
-    first: bool,
+    query: Query,
     poses: Option<String>,
     stats: bool,
     time: bool,
@@ -50,11 +68,21 @@ fn parse_args(args: &[String]) -> Result<Args, String> {
         bv: "kdop18".into(),
         build: BuildOptions::default(),
         rotation: RotationUpdate::Auto,
-        first: false,
+        query: Query::Pairs,
         poses: None,
         stats: false,
         time: false,
     };
+    // At most one of --first, --distance, --within.
+    fn set_query(slot: &mut Query, q: Query, name: &str) -> Result<(), String> {
+        if *slot != Query::Pairs {
+            return Err(format!(
+                "{name}: only one of --first, --distance, --within ({USAGE})"
+            ));
+        }
+        *slot = q;
+        Ok(())
+    }
     let mut it = args.iter();
     while let Some(arg) = it.next() {
         let mut value = |name: &str| {
@@ -94,7 +122,21 @@ fn parse_args(args: &[String]) -> Result<Args, String> {
                 }
             }
             "--poses" => out.poses = Some(value("--poses")?),
-            "--first" => out.first = true,
+            "--first" => set_query(&mut out.query, Query::First, "--first")?,
+            "--distance" => set_query(&mut out.query, Query::Distance, "--distance")?,
+            "--within" => {
+                let v = value("--within")?;
+                match v.parse::<f64>() {
+                    Ok(d) if d.is_finite() && d >= 0.0 => {
+                        set_query(&mut out.query, Query::Within(d), "--within")?
+                    }
+                    _ => {
+                        return Err(format!(
+                            "--within needs a finite non-negative distance, got '{v}'"
+                        ))
+                    }
+                }
+            }
             "--stats" => out.stats = true,
             "--time" => out.time = true,
             s if s.starts_with("--") => return Err(format!("unknown option '{s}' ({USAGE})")),
@@ -156,6 +198,14 @@ fn run(args: &[String]) -> Result<String, String> {
     }
 }
 
+/// One pose's answer, formatted after the timed loop.
+enum Answer {
+    Pairs(usize),
+    Hit(bool),
+    Distance(f64, u32, u32),
+    Within(bool),
+}
+
 fn queries<BV: BoundingVolume>(
     args: &Args,
     a: TriMesh,
@@ -165,19 +215,32 @@ fn queries<BV: BoundingVolume>(
     let a = Mesh::<BV>::from_trimesh(a, args.build).map_err(|e| e.to_string())?;
     let b = Mesh::<BV>::from_trimesh(b, args.build).map_err(|e| e.to_string())?;
     let mut collider = Collider::<BV>::new(args.rotation);
-    let mut results: Vec<(usize, CostCounters)> = Vec::with_capacity(poses.len());
+    let mut proximity = Proximity::<BV>::new(args.rotation);
+    let mut results: Vec<(Answer, CostCounters)> = Vec::with_capacity(poses.len());
     let start = Instant::now();
     for pose in poses {
-        let r = if args.first {
-            let f = collider
-                .first_contact(&a, pose, &b)
-                .map_err(|e| e.to_string())?;
-            (f.pair.is_some() as usize, f.counters)
-        } else {
-            let c = collider
-                .all_pairs(&a, pose, &b)
-                .map_err(|e| e.to_string())?;
-            (c.pairs.len(), c.counters)
+        let r = match args.query {
+            Query::First => {
+                let f = collider.first_contact(&a, pose, &b);
+                let f = f.map_err(|e| e.to_string())?;
+                (Answer::Hit(f.pair.is_some()), f.counters)
+            }
+            Query::Pairs => {
+                let c = collider.all_pairs(&a, pose, &b);
+                let c = c.map_err(|e| e.to_string())?;
+                (Answer::Pairs(c.pairs.len()), c.counters)
+            }
+            Query::Distance => {
+                let d = proximity.distance(&a, pose, &b);
+                let d = d.map_err(|e| e.to_string())?;
+                let (i, j) = d.triangles;
+                (Answer::Distance(d.distance, i, j), d.counters)
+            }
+            Query::Within(margin) => {
+                let w = proximity.within(&a, pose, &b, margin);
+                let w = w.map_err(|e| e.to_string())?;
+                (Answer::Within(w), proximity.counters())
+            }
         };
         results.push(r);
     }
@@ -193,11 +256,12 @@ fn queries<BV: BoundingVolume>(
         );
     }
     let mut out = String::new();
-    for (n, c) in results {
-        let _ = if args.first {
-            write!(out, "hit {n}")
-        } else {
-            write!(out, "pairs {n}")
+    for (answer, c) in results {
+        let _ = match answer {
+            Answer::Pairs(n) => write!(out, "pairs {n}"),
+            Answer::Hit(h) => write!(out, "hit {}", h as u8),
+            Answer::Distance(d, i, j) => write!(out, "distance {} {i} {j}", significant9(d)),
+            Answer::Within(w) => write!(out, "within {}", w as u8),
         };
         if args.stats {
             let _ = write!(out, " nv {} np {} nu {}", c.nv, c.np, c.nu);
@@ -205,6 +269,31 @@ fn queries<BV: BoundingVolume>(
         out.push('\n');
     }
     Ok(out)
+}
+
+/// `x` with 9 significant digits, as C's `%.9g`: positional for exponents from
+/// -4 to 8, else `1.5e-07` / `2.5e+20` form; trailing zeros dropped.
+fn significant9(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    // Rounded to 9 digits first: the exponent is the rounded value's.
+    let sci = format!("{x:.8e}");
+    let (mantissa, exp) = sci.split_once('e').unwrap_or((&sci, "0"));
+    let exp: i32 = exp.parse().unwrap_or(0);
+    let trim = |s: &str| {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s.to_string()
+        }
+    };
+    if (-4..9).contains(&exp) {
+        trim(&format!("{x:.*}", (8 - exp) as usize))
+    } else {
+        let sign = if exp < 0 { '-' } else { '+' };
+        format!("{}e{sign}{:02}", trim(mantissa), exp.abs())
+    }
 }
 
 #[cfg(test)]
@@ -219,6 +308,48 @@ mod tests {
         assert!(parse_args(&s(&["a", "b", "--leaf", "0"])).is_err());
         assert!(parse_args(&s(&["a", "b", "--split"])).is_err());
         let a = parse_args(&s(&["a", "b", "--bv", "obb", "--first", "--split", "sah"])).unwrap();
-        assert!(a.first && a.bv == "obb" && a.build.split == SplitRule::Sah);
+        assert!(a.query == Query::First && a.bv == "obb" && a.build.split == SplitRule::Sah);
+        for bad in [
+            &["a", "b", "--within"][..],
+            &["a", "b", "--within", "-1"],
+            &["a", "b", "--within", "NaN"],
+            &["a", "b", "--within", "inf"],
+            &["a", "b", "--within", "x"],
+            &["a", "b", "--distance", "--first"],
+            &["a", "b", "--first", "--within", "1"],
+            &["a", "b", "--within", "1", "--distance"],
+        ] {
+            assert!(parse_args(&s(bad)).is_err(), "{bad:?}");
+        }
+        let a = parse_args(&s(&["a", "b", "--within", "2.5"])).unwrap();
+        assert_eq!(a.query, Query::Within(2.5));
+        let a = parse_args(&s(&["a", "b", "--within", "0", "--stats"])).unwrap();
+        assert!(a.query == Query::Within(0.0) && a.stats);
+        let a = parse_args(&s(&["--distance", "a", "b"])).unwrap();
+        assert!(a.query == Query::Distance && a.a == "a" && a.b == "b");
+    }
+
+    #[test]
+    fn nine_significant_digits() {
+        for (x, want) in [
+            (0.0, "0"),
+            (2.0, "2"),
+            (0.1, "0.1"),
+            (1.0 / 3.0, "0.333333333"),
+            (123456789.4, "123456789"),
+            (999999999.6, "1e+09"),
+            (1234567890.0, "1.23456789e+09"),
+            (9.9999999996, "10"),
+            (1e-5, "1e-05"),
+            (1.25e-5, "1.25e-05"),
+            (0.0001234567891, "0.000123456789"),
+            (3.0e37, "3e+37"),
+            (f64::MIN_POSITIVE, "2.22507386e-308"),
+        ] {
+            assert_eq!(significant9(x), want, "{x:e}");
+            // Within half a unit of the 9th digit.
+            let back: f64 = want.parse().unwrap();
+            assert!((back - x).abs() <= 5e-9 * x.abs(), "{x:e} {want}");
+        }
     }
 }

@@ -43,9 +43,11 @@ enum Command {
     Demo(demo::Args),
     /// Replay a recorded scene trace against one index or all of them.
     Replay(replay::Args),
-    /// Mesh-vs-mesh contacts (exact triangle pairs) with cost counters (docs/sources.md#bvh-cost):
+    /// Mesh-vs-mesh contacts (exact triangle pairs), distances or proximity tests with cost
+    /// counters (docs/sources.md#bvh-cost):
     /// `collide A B [--bv aabb|kdop14|kdop18|kdop26|obb|sphere] [--split mean|median|sah]
-    /// [--first] [--poses FILE] [--stats] [--time] [--leaf N] [--rotation auto|refit|conservative]`.
+    /// [--first | --distance | --within D] [--poses FILE] [--stats] [--time] [--leaf N]
+    /// [--rotation auto|refit|conservative]`.
     #[command(disable_help_flag = true)]
     Collide {
         /// Meshes and options, parsed by the command itself.

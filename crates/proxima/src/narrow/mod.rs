@@ -19,6 +19,7 @@
 mod bv;
 mod bvh;
 mod coplanar;
+mod distance;
 pub(crate) mod predicates;
 mod prepared;
 mod ray_triangle;
@@ -34,6 +35,10 @@ pub use bvh::{
     RayBvh, RotationUpdate, SplitRule,
 };
 pub(crate) use bvh::{rotation_deviation, CutRecorder};
+pub use distance::{
+    closest_point_on_triangle, mesh_distance, meshes_within, triangle_distance, ClosestPoint,
+    MeshDistance, NearPair, NearPairs, Proximity, TriangleDistance,
+};
 pub use prepared::PreparedTriangle;
 pub use ray_triangle::{ray_triangle, TriangleHit};
 pub use segment::{segment_triangle_intersect, segments_intersect};

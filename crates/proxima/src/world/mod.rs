@@ -13,7 +13,10 @@
 //! - [`World::ray_cast`] / [`World::ray_hits`]: the first triangle a ray hits,
 //!   and every object it hits (`ray.rs`);
 //! - [`World::overlap_sphere`], [`World::cull`]: objects near a point, objects in
-//!   a view frustum (`region.rs`).
+//!   a view frustum (`region.rs`);
+//! - [`World::distance`], [`World::nearest_obstacle`], [`World::contacts_within`]:
+//!   how far apart two objects are, the nearest obstacle of one, contacts with a
+//!   margin (`distance.rs`).
 //!
 //! The broad phase (`broad.rs`) is an [`AnyIndex`](crate::broad::AnyIndex) chosen
 //! at run time ([`WorldConfig::index`]) over each object's bounding sphere; the
@@ -43,6 +46,7 @@
 mod broad;
 mod coherence;
 mod contacts;
+mod distance;
 mod ignore;
 mod pair;
 #[cfg(feature = "parallel")]
@@ -53,6 +57,7 @@ mod shape;
 mod validate;
 
 pub use contacts::{ContactMode, ContactReport, ObjectContact, WorldCounters};
+pub use distance::ObjectDistance;
 pub use ray::WorldRayHit;
 pub use shape::Shape;
 

@@ -158,6 +158,23 @@ pub(crate) fn test_pair<T, BV: BoundingVolume>(
     Ok(outcome)
 }
 
+/// A ball's centre in a mesh object's frame; fails with [`Error::InvalidPose`]
+/// beyond `f32` range.
+pub(crate) fn centre_in<T, BV>(
+    ball: &Object<T, BV>,
+    mesh_obj: &Object<T, BV>,
+) -> Result<glam::Vec3> {
+    let c = mesh_obj
+        .inverse
+        .transform_point3(ball.pose.translation.into());
+    if !c.is_finite() {
+        return Err(Error::InvalidPose(
+            "a ball's centre in a mesh's frame is beyond f32 range".into(),
+        ));
+    }
+    Ok(c)
+}
+
 /// A ball (object `ball`, radius `r`) against a mesh: the ball's centre moved into
 /// the mesh's frame, then [`Mesh::visit_sphere`](crate::narrow::Mesh). Appends
 /// `(0, triangle)`, or `(triangle, 0)` when `mesh_first`.
@@ -173,14 +190,7 @@ fn ball_mesh<T, BV: BoundingVolume>(
     mesh_first: bool,
     outcome: &mut PairOutcome,
 ) -> Result<()> {
-    let c = mesh_obj
-        .inverse
-        .transform_point3(ball.pose.translation.into());
-    if !c.is_finite() {
-        return Err(Error::InvalidPose(
-            "a ball's centre in a mesh's frame is beyond f32 range".into(),
-        ));
-    }
+    let c = centre_in(ball, mesh_obj)?;
     scratch.hits.clear();
     let counters = mesh.visit_sphere(
         &Sphere::new(c, r),

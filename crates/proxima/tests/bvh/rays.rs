@@ -389,6 +389,75 @@ fn parallel_batches_equal_sequential_casts() {
     assert!(b.cast_rays_par(mesh.trimesh(), &rays).is_ok());
 }
 
+/// Regression: coordinates beyond `√f32::MAX ≈ 1.8e19` (where a squared
+/// distance overflows `f32`) up to `f32::MAX`. A sphere volume fitted there had
+/// an infinite radius, and its ray test then missed everything; an OBB fitted to
+/// points near `±f32::MAX` had a NaN centre (its `lo + hi` overflowed). Every
+/// volume's tree and the mesh's ray tree must cast as brute force.
+#[test]
+fn huge_coordinates_cast_with_every_volume() {
+    fn cast_all<BV: BoundingVolume>(m: &TriMesh, rays: &[Ray], wants: &[Option<(u32, f32)>]) {
+        check_bvh::<BV>(m, rays, wants);
+        let mesh = Mesh::<BV>::from_trimesh(m.clone(), BuildOptions::default()).unwrap();
+        for (k, (ray, want)) in rays.iter().zip(wants).enumerate() {
+            let got = mesh.cast_ray(ray).unwrap().map(|h| (h.triangle, h.t));
+            assert_eq!(got, *want, "Mesh<{}> ray {k} {ray:?}", BV::NAME);
+            assert_eq!(mesh.intersects_ray(ray).unwrap(), want.is_some());
+        }
+    }
+    let mut rng = Pcg64::seed_from_u64(77);
+    for s in [1e18f32, 2e19, 1e25, 1e30, 1e38, f32::MAX] {
+        // A closed ball of radius `s` and, near its centre, one small triangle.
+        let ball = uv_sphere(Vec3::ZERO, s, 12, 8);
+        let mut v = ball.vertices().to_vec();
+        let mut t = ball.triangles().to_vec();
+        let base = v.len() as u32;
+        v.extend([
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::new(2.0, 2.0, 3.0),
+            Vec3::new(1.0, 3.0, 3.0),
+        ]);
+        t.push([base, base + 1, base + 2]);
+        let m = TriMesh::new(v, t).unwrap();
+        // From inside (the centre, the small triangle's neighbourhood, half way
+        // out) in random directions, and from outside towards the centre where
+        // that is in range.
+        let mut rays = vec![
+            Ray::new(Vec3::new(1.2, 2.2, 0.0), Vec3::Z),
+            Ray::new(Vec3::new(1.2, 2.2, 0.0), -Vec3::Z),
+        ];
+        for k in 0..60 {
+            let d = Vec3::new(
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+            )
+            .normalize_or(Vec3::X);
+            let o = match k % 3 {
+                0 => Vec3::ZERO,
+                1 => Vec3::new(1.0, 2.0, 2.0),
+                _ => d.any_orthonormal_vector() * (s * 0.5),
+            };
+            rays.push(Ray::new(o, d));
+            if s <= 1e30 {
+                rays.push(Ray::new(-d * (s * 3.0), d));
+            }
+        }
+        let wants: Vec<_> = rays.iter().map(|r| brute(&m, r)).collect();
+        assert!(
+            wants.iter().all(|w| w.is_some()),
+            "scale {s}: every ray hits"
+        );
+        assert_eq!(wants[0].map(|w| w.0), Some(ball.len() as u32), "scale {s}");
+        cast_all::<Aabb>(&m, &rays, &wants);
+        cast_all::<Kdop14>(&m, &rays, &wants);
+        cast_all::<Kdop18>(&m, &rays, &wants);
+        cast_all::<Kdop26>(&m, &rays, &wants);
+        cast_all::<Obb>(&m, &rays, &wants);
+        cast_all::<Sphere>(&m, &rays, &wants);
+    }
+}
+
 /// [`RayBvh`]'s descent is specialised per octant of the ray direction, with the
 /// slab sides and the widened inverse direction chosen per ray; rays with a zero
 /// or subnormal direction component and one-leaf trees take the general path.

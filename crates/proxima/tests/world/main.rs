@@ -5,6 +5,7 @@
 
 mod brute;
 mod coherence;
+mod distance;
 mod errors;
 mod oracle;
 #[cfg(feature = "parallel")]

@@ -1,6 +1,6 @@
 //! The AABB (6-DOP) as a BVH bounding volume.
 
-use super::{clip_slab, BoundingVolume};
+use super::{box_gap, clip_slab, BoundingVolume};
 use crate::geom::{Aabb, Ray};
 use glam::{Affine3A, Vec3};
 
@@ -90,5 +90,17 @@ impl BoundingVolume for Aabb {
             }
         }
         Some(t0)
+    }
+
+    /// The distance between the moved box (grown by the slack) and `o`. Exact for
+    /// boxes, up to the slack.
+    #[inline]
+    fn distance_lower_bound(&self, m: &Self::Motion, o: &Self) -> f32 {
+        box_gap(self.min + m.0, self.max + m.1, o.min, o.max)
+    }
+
+    #[inline(always)]
+    fn distance_lower_bound_fixed(&self, o: &Self) -> f32 {
+        box_gap(self.min, self.max, o.min, o.max)
     }
 }

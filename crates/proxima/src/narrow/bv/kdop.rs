@@ -1,6 +1,6 @@
 //! k-DOPs (discrete orientation polytopes) with K = 14, 18, 26 [sources: kdop].
 
-use super::{clip_slab, BoundingVolume};
+use super::{clip_slab, wide_gap, BoundingVolume};
 use crate::geom::Ray;
 use crate::{Error, Result};
 use glam::{Affine3A, Mat3A, Vec3, Vec3A};
@@ -218,6 +218,57 @@ impl<const K: usize> Kdop<K> {
             self.d[i] <= v && v <= self.d[i + Self::H]
         })
     }
+
+    /// `1 / |axis_i|` for the slabs after the coordinate ones: corner diagonals
+    /// have length √3, edge diagonals √2.
+    #[inline(always)]
+    fn inv_norm(i: usize) -> f32 {
+        if Self::axis_index(i) < 7 {
+            0.577_350_26
+        } else {
+            std::f32::consts::FRAC_1_SQRT_2
+        }
+    }
+
+    /// The distance lower bound of `self` shifted by `m` (a [`BoundingVolume::motion`],
+    /// or no shift) and `o`: the Euclidean gap of the three coordinate slabs (the
+    /// boxes' distance), or the largest gap of another slab divided by its axis'
+    /// length, whichever is larger. Each is a lower bound on the distance of the
+    /// contents. Written as plain loops over the slabs (no NaN-aware `max`, no
+    /// zero shift added) because it runs once per volume pair; a result that
+    /// overflowed or is NaN is computed again in `f64` ([`wide_gap`]).
+    #[inline(always)]
+    fn gap(&self, m: Option<&[f32; K]>, o: &Self) -> f32 {
+        let h = Self::H;
+        // Slab `i` of `self` (moved) and of `o`.
+        let slab = |i: usize| {
+            let (lo, hi) = match m {
+                Some(m) => (self.d[i] + m[i], self.d[i + h] + m[i + h]),
+                None => (self.d[i], self.d[i + h]),
+            };
+            (lo, hi, o.d[i], o.d[i + h])
+        };
+        let g = |i: usize| {
+            let (lo, hi, lo_o, hi_o) = slab(i);
+            fmax(lo_o - hi, lo - hi_o)
+        };
+        let mut sq = 0.0f32;
+        for i in 0..3 {
+            let x = fmax(g(i), 0.0);
+            sq += x * x;
+        }
+        let mut slabs = 0.0f32;
+        for i in 3..h {
+            slabs = fmax(slabs, g(i) * Self::inv_norm(i));
+        }
+        let r = fmax(sq.sqrt(), slabs);
+        if r <= f32::MAX {
+            r
+        } else {
+            // Overflowed (gaps beyond √f32::MAX) or NaN (infinite interval ends).
+            wide_gap(slab, h, |i| if i < 3 { 1.0 } else { Self::inv_norm(i) })
+        }
+    }
 }
 
 impl<const K: usize> BoundingVolume for Kdop<K> {
@@ -391,6 +442,16 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
             }
         }
         Some(t0)
+    }
+
+    #[inline]
+    fn distance_lower_bound(&self, m: &Self::Motion, o: &Self) -> f32 {
+        self.gap(Some(&m.d), o)
+    }
+
+    #[inline]
+    fn distance_lower_bound_fixed(&self, o: &Self) -> f32 {
+        self.gap(None, o)
     }
 }
 

@@ -9,6 +9,7 @@ mod sphere;
 
 pub use kdop::{Kdop, Kdop14, Kdop18, Kdop26};
 pub use obb::Obb;
+pub(crate) use sphere::enclosing_radius;
 
 use crate::geom::Ray;
 use glam::{Affine3A, Vec3};
@@ -132,6 +133,88 @@ pub trait BoundingVolume: Copy + Debug + Send + Sync + 'static {
     /// The entry parameter of `ray` into the volume enlarged by `slack`, clipped to
     /// `[0, ray.max_t]`, or `None` if the ray misses it. Conservative.
     fn ray_entry(&self, ray: &Ray, slack: f32) -> Option<f32>;
+
+    /// A lower bound on the distance between `self` (in the moving frame, moved by
+    /// `motion`) and `other` (in the fixed frame), `0` when they may overlap: the
+    /// cut of the distance queries ([`Proximity`](crate::narrow::Proximity)).
+    /// The motion's slack is subtracted, so the bound holds for the points the
+    /// volumes were fitted to despite rounding. Never negative, never NaN for
+    /// finite input. Cost: about that of [`BoundingVolume::overlaps`] (k-DOPs and
+    /// AABBs: the Euclidean gap of the coordinate slabs, then the largest gap of
+    /// the other slabs over their normalized axes; OBBs: the largest gap over the
+    /// separating axes; spheres: exact).
+    fn distance_lower_bound(&self, motion: &Self::Motion, other: &Self) -> f32;
+
+    /// [`BoundingVolume::distance_lower_bound`] of two volumes in the same frame,
+    /// without slack (the caller has [`inflated`](BoundingVolume::inflated) one of
+    /// them).
+    fn distance_lower_bound_fixed(&self, other: &Self) -> f32 {
+        self.distance_lower_bound(&Self::motion(&Affine3A::IDENTITY, 0.0), other)
+    }
+}
+
+/// The distance between the boxes `[lo_a, hi_a]` and `[lo_b, hi_b]` (`0` if they
+/// overlap): the Euclidean norm of the per-axis gaps (the AABB's lower bound).
+/// Where the `f32` squares overflow (gaps beyond `√f32::MAX ≈ 1.8e19`), in `f64`
+/// ([`f32_below`]).
+#[inline(always)]
+pub(crate) fn box_gap(lo_a: Vec3, hi_a: Vec3, lo_b: Vec3, hi_b: Vec3) -> f32 {
+    let g = (lo_b - hi_a).max(lo_a - hi_b).max(Vec3::ZERO).length();
+    if g <= f32::MAX {
+        g
+    } else {
+        wide_gap(|i| (lo_a[i], hi_a[i], lo_b[i], hi_b[i]), 3, |_| 1.0)
+    }
+}
+
+/// A lower bound computed in `f64` as an `f32` lower bound: rounded down, at
+/// most `f32::MAX`, `0` for NaN (an undefined gap bounds nothing).
+pub(crate) fn f32_below(x: f64) -> f32 {
+    if x.is_nan() || x <= 0.0 {
+        return 0.0;
+    }
+    let f = (x as f32).min(f32::MAX);
+    if f as f64 > x {
+        f32::from_bits(f.to_bits() - 1)
+    } else {
+        f
+    }
+}
+
+/// The slab-gap lower bound in `f64`, for where the `f32` one overflowed: slab
+/// `i < n` has the intervals `(lo_a, hi_a, lo_b, hi_b) = slab(i)` and the axis
+/// scale `scale(i)` (`1 / |axis|`); the Euclidean norm of the three coordinate
+/// slabs' gaps, or the largest scaled gap of the others. A NaN gap (infinite
+/// ends) counts as none. Cold: only gaps beyond `√f32::MAX ≈ 1.8e19` come here.
+#[cold]
+#[inline(never)]
+pub(crate) fn wide_gap(
+    slab: impl Fn(usize) -> (f32, f32, f32, f32),
+    n: usize,
+    scale: impl Fn(usize) -> f32,
+) -> f32 {
+    let gap = |i: usize| {
+        let (lo_a, hi_a, lo_b, hi_b) = slab(i);
+        let g = (lo_b as f64 - hi_a as f64).max(lo_a as f64 - hi_b as f64);
+        if g > 0.0 {
+            g * scale(i) as f64
+        } else {
+            0.0
+        }
+    };
+    let sq: f64 = (0..3).map(|i| gap(i) * gap(i)).sum();
+    f32_below((3..n).map(gap).fold(sq.sqrt(), f64::max))
+}
+
+/// `x` if positive, else `+0.0` (also for NaN and `-0.0`): lower bounds stay
+/// non-negative, so their bit patterns sort like their values.
+#[inline(always)]
+pub(crate) fn positive(x: f32) -> f32 {
+    if x > 0.0 {
+        x
+    } else {
+        0.0
+    }
 }
 
 /// Clips the ray interval `[t0, t1]` by the slab `lo <= o + t*d <= hi` (one axis of

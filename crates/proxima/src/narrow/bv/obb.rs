@@ -3,9 +3,9 @@
 // Index loops read like the matrix formulas they implement.
 #![allow(clippy::needless_range_loop)]
 
-use super::{clip_slab, BoundingVolume};
+use super::{clip_slab, positive, BoundingVolume};
 use crate::geom::Ray;
-use glam::{Affine3A, Mat3, Mat3A, Vec3, Vec3A};
+use glam::{Affine3A, Mat3, Mat3A, Vec3, Vec3A, Vec3Swizzles};
 
 /// An oriented box: `center + axes * u` for `|u_i| <= half[i]`, `axes` orthonormal
 /// (columns). Fitted by principal component analysis (the triangle-area covariance of
@@ -25,6 +25,8 @@ pub struct Obb {
 
 impl Obb {
     /// The box with the given axes that bounds `points` (non-empty). O(points).
+    /// Finite for every finite point set bounded along the axes within the `f32`
+    /// range (an extent wider than `f32::MAX` is halved before it is formed).
     pub fn with_axes(axes: Mat3, points: impl Iterator<Item = Vec3>) -> Obb {
         let at = axes.transpose();
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -34,11 +36,29 @@ impl Obb {
             lo = lo.min(q);
             hi = hi.max(q);
         }
-        Obb {
-            center: axes * ((lo + hi) * 0.5),
-            axes,
-            half: (hi - lo) * 0.5,
+        let (mut mid, mut half) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+        if !(mid.is_finite() && half.is_finite()) {
+            // The sum or difference overflowed (extents near `f32::MAX`): halving
+            // first is exact at these magnitudes (it only rounds subnormals).
+            (mid, half) = (lo * 0.5 + hi * 0.5, hi * 0.5 - lo * 0.5);
         }
+        Obb {
+            center: axes * mid,
+            axes,
+            half,
+        }
+    }
+
+    /// This box moved by the motion `m`, seen in `o`'s frame: the matrix whose
+    /// column `j` is this box's axis `j` (so `c.col(j)[i] = b_i · a_j`), and the
+    /// centre offset. The common start of both separating-axis tests.
+    #[inline(always)]
+    fn in_frame_of(&self, m: &<Obb as BoundingVolume>::Motion, o: &Obb) -> (Mat3A, Vec3A) {
+        let (rot, tr, _) = *m;
+        let bt = Mat3A::from(o.axes).transpose();
+        let c = bt * (rot * Mat3A::from(self.axes));
+        let ca = rot * Vec3A::from(self.center) + tr;
+        (c, bt * (ca - Vec3A::from(o.center)))
     }
 
     /// The 8 corners.
@@ -213,13 +233,8 @@ impl BoundingVolume for Obb {
     /// whose cross product is almost zero).
     #[inline]
     fn overlaps(&self, m: &Self::Motion, o: &Self) -> bool {
-        let (rot, tr, slack) = *m;
-        let aw = rot * Mat3A::from(self.axes);
-        let bt = Mat3A::from(o.axes).transpose();
-        // c[j] = A's axis j in B's frame; column-major: c.col(j)[i] = b_i · a_j.
-        let c = bt * aw;
-        let ca = rot * Vec3A::from(self.center) + tr;
-        let t = bt * (ca - Vec3A::from(o.center));
+        let slack = m.2;
+        let (c, t) = self.in_frame_of(m, o);
         let (a, b) = (Vec3A::from(self.half), Vec3A::from(o.half));
         let c0 = c.x_axis;
         let c1 = c.y_axis;
@@ -256,6 +271,59 @@ impl BoundingVolume for Obb {
             }
         }
         true
+    }
+
+    /// The largest gap over the 15 separating axes of [`BoundingVolume::overlaps`]
+    /// (each a lower bound on the boxes' distance), the slack subtracted. The 9
+    /// edge axes `b_i × a_j` are not unit (`sqrt(1 - (b_i · a_j)²)` for a true
+    /// rotation): their gap is divided by the length, computed from the moved axes
+    /// and slightly overestimated so that the bound stays a bound, and
+    /// axes shorter than 0.05 (nearly parallel edges, where rounding dominates)
+    /// are skipped.
+    #[inline]
+    fn distance_lower_bound(&self, m: &Self::Motion, o: &Self) -> f32 {
+        let slack = m.2;
+        let (c, t) = self.in_frame_of(m, o);
+        let (a, b) = (Vec3A::from(self.half), Vec3A::from(o.half));
+        let cc = [c.x_axis, c.y_axis, c.z_axis];
+        let ab = cc.map(|v| v.abs());
+        // B's axes, then A's: unit vectors.
+        let ra = ab[0] * a.x + ab[1] * a.y + ab[2] * a.z;
+        let tj = Vec3A::new(t.dot(cc[0]), t.dot(cc[1]), t.dot(cc[2]));
+        let rb = Vec3A::new(ab[0].dot(b), ab[1].dot(b), ab[2].dot(b));
+        let mut best = (t.abs() - b - ra).max(tj.abs() - a - rb).max_element() - slack;
+        // Edge axes e_i × c_j (in B's frame), the three i at once per j: the
+        // projection of t is (t × c_j)_i; B's radius b_i1 |c_j,i2| + b_i2 |c_j,i1|;
+        // A's radius a_j1 |c_j2,i| + a_j2 |c_j1,i|; the squared length
+        // |c_j|² - c_j,i² (exact for a pose that is not quite a rotation).
+        let (by, bz) = (b.yzx(), b.zxy());
+        for j in 0..3 {
+            let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+            let cj = cc[j];
+            let lhs = t.cross(cj).abs();
+            let rhs = by * ab[j].zxy() + bz * ab[j].yzx() + ab[j2] * a[j1] + ab[j1] * a[j2];
+            let len2 = Vec3A::splat(cj.length_squared()) - cj * cj;
+            // Slack first, then the division: the smaller (sound) bound; axes
+            // shorter than 0.05 (near-parallel edges) are skipped.
+            let gap = lhs - rhs - Vec3A::splat(slack);
+            let ok = gap.cmpgt(Vec3A::ZERO) & len2.cmpge(Vec3A::splat(0.0025));
+            if ok.any() {
+                // gap / |L| through its square: one square root for the three;
+                // three where the square overflows (gaps beyond √f32::MAX).
+                let q2 = Vec3A::select(ok, gap * gap / len2, Vec3A::ZERO).max_element();
+                let q = if q2 <= f32::MAX {
+                    q2.sqrt()
+                } else {
+                    (0..3)
+                        .filter(|&i| ok.bitmask() & (1 << i) != 0)
+                        .map(|i| gap[i] / len2[i].sqrt())
+                        .fold(0.0f32, f32::max)
+                        .min(f32::MAX)
+                };
+                best = best.max(q * (1.0 / 1.001));
+            }
+        }
+        positive(best)
     }
 
     fn inflated(&self, slack: f32) -> Self {

@@ -3,9 +3,11 @@
 //! counters of [sources: bvh-cost].
 
 use super::mesh::Mesh;
-use super::traverse::{traverse, ExactLeaves, Lazy, Local, Precomputed, Terminal};
-use super::tri_cache::{QueryCache, TriangleCache};
-use crate::narrow::bv::{slack_for, BoundingVolume};
+use super::moving::{query_slack, Descent, LowerBounds, Moved, MovingVolumes};
+use super::traverse::{traverse, Terminal};
+use super::tree::Bvh;
+use super::tri_cache::TriangleCache;
+use crate::narrow::bv::BoundingVolume;
 use crate::narrow::PreparedTriangle;
 use crate::{Error, Result};
 use glam::{Affine3A, Mat3A, Vec3};
@@ -20,8 +22,9 @@ const MAX_POSE_DEVIATION: f32 = 1e-3;
 /// (OBB, sphere) ignore this: their test takes the pose directly.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum RotationUpdate {
-    /// Currently [`RotationUpdate::Conservative`] for every query. Chosen from the
-    /// W5 benchmark (`proxima-bench w5 --rotation ...`): since triangle pairs are
+    /// For collision, [`RotationUpdate::Conservative`] (for the distance queries,
+    /// see [`Proximity::rotation`](crate::narrow::Proximity::rotation)). Chosen
+    /// from the W5 benchmark (`proxima-bench w5 --rotation ...`): since triangle pairs are
     /// tested through [`PreparedTriangle`](crate::narrow::PreparedTriangle), the
     /// extra pair tests of the looser volumes cost less than refitting every node
     /// (rob vs env, k-DOP18 all pairs: 34 µs mean conservative vs 40–43 µs refit;
@@ -74,9 +77,7 @@ pub struct FirstContact {
 pub struct Collider<BV> {
     /// How axis-aligned volumes follow rotations.
     pub rotation: RotationUpdate,
-    world_vertices: Vec<Vec3>,
-    world: Vec<BV>,
-    cache: QueryCache<BV>,
+    moving: MovingVolumes<BV>,
     stack: Vec<(u32, u32)>,
     /// Prepared triangles of the moving mesh (world frame) and of the fixed one.
     tris_a: TriangleCache,
@@ -148,9 +149,7 @@ impl<BV: BoundingVolume> Collider<BV> {
     pub fn new(rotation: RotationUpdate) -> Self {
         Collider {
             rotation,
-            world_vertices: Vec::new(),
-            world: Vec::new(),
-            cache: QueryCache::default(),
+            moving: MovingVolumes::default(),
             stack: Vec::new(),
             tris_a: TriangleCache::default(),
             tris_b: TriangleCache::default(),
@@ -246,29 +245,23 @@ impl<BV: BoundingVolume> Collider<BV> {
         cut: &mut impl Terminal,
     ) -> (CostCounters, bool) {
         // A mesh's tree always matches its geometry: nothing else to check.
-        let (ta, ma) = (a.bvh(), a.trimesh());
-        let (tb, mb) = (b.bvh(), b.trimesh());
-        let t1 = glam::Vec3::from(pose.translation).abs().element_sum();
-        let scale = 2.0 * (1.8 * ta.coord_bound * (1.0 + dev) + t1 + tb.coord_bound);
-        let slack = slack_for(scale, dev);
-        let (va, vb) = (ma.vertices(), mb.vertices());
+        let (ta, tb) = (a.bvh(), b.bvh());
+        let slack = query_slack(ta, pose, dev, tb);
+        let vb = b.trimesh().vertices();
         let mut c = CostCounters::default();
         let Collider {
             rotation,
-            world_vertices,
-            world,
-            cache,
+            moving,
             stack,
             tris_a,
             tris_b,
         } = self;
         tris_a.begin(ta.tris.len(), Default::default());
         tris_b.begin(tb.tris.len(), Default::default());
-        let rotated = pose.matrix3 != Mat3A::IDENTITY;
         let mut np = 0u64;
         // Leaf pair: every triangle pair, the first mesh's corners from `corner`.
         // Each triangle is prepared (corners moved, box, plane) once per query.
-        let mut leaf = |corner: &dyn Fn(u32) -> Vec3, la: usize, lb: usize| -> bool {
+        let leaf = |corner: &dyn Fn(u32) -> Vec3, la: usize, lb: usize| -> bool {
             for k in ta.nodes[la].triangle_range() {
                 let pa = tris_a.get(k, || PreparedTriangle::new(ta.tris[k].map(corner)));
                 for m in tb.nodes[lb].triangle_range() {
@@ -290,62 +283,66 @@ impl<BV: BoundingVolume> Collider<BV> {
             }
             false
         };
-        let moved = |v: u32| pose.transform_point3(va[v as usize]);
-        // The descent, ordered deepest overlap first for a first contact.
-        macro_rules! go {
-            ($src:expr, $corner:expr) => {
-                if first {
-                    traverse::<BV, true>(ta, $src, tb, start, stack, &mut c.nv, cut, |x, y| {
-                        leaf($corner, x, y)
-                    })
-                } else {
-                    traverse::<BV, false>(ta, $src, tb, start, stack, &mut c.nv, cut, |x, y| {
-                        leaf($corner, x, y)
-                    })
-                }
-            };
-        }
-        let stopped = if BV::AXIS_ALIGNED && rotated {
-            let update = match *rotation {
-                RotationUpdate::Auto => RotationUpdate::Conservative,
-                r => r,
-            };
-            match update {
-                RotationUpdate::Refit => {
-                    world_vertices.clear();
-                    world_vertices.extend(va.iter().map(|&v| pose.transform_point3(v)));
-                    c.nu = ta.world_volumes(world_vertices, slack, world);
-                    let wv: &[Vec3] = world_vertices;
-                    let corner = |v: u32| wv[v as usize];
-                    go!(&mut Precomputed(world), &corner)
-                }
-                _ => {
-                    cache.begin(ta.nodes.len(), ta.nodes[0].bv);
-                    let mut src = ExactLeaves {
-                        lazy: Lazy {
-                            nodes: &ta.nodes,
-                            pose: *pose,
-                            slack,
-                            cache,
-                            updates: 0,
-                        },
-                        tris: &ta.tris,
-                        vertices: va,
-                        sizes: &ta.subtree,
-                    };
-                    let stopped = go!(&mut src, &moved);
-                    c.nu = src.lazy.updates;
-                    stopped
-                }
-            }
-        } else {
-            let mut src = Local {
-                nodes: &ta.nodes,
-                motion: BV::motion(pose, slack),
-            };
-            go!(&mut src, &moved)
+        let d = Traversal {
+            a: ta,
+            b: tb,
+            first,
+            start,
+            stack,
+            nv: &mut c.nv,
+            cut,
+            leaf,
         };
+        let (nu, stopped) = moving.descend(a, pose, slack, *rotation, d);
+        c.nu = nu;
         c.np = np;
         (c, stopped)
+    }
+}
+
+/// The collision descent ([`traverse`]) with a leaf-pair test, for any source
+/// of the moving volumes.
+struct Traversal<'q, BV, C, L> {
+    a: &'q Bvh<BV>,
+    b: &'q Bvh<BV>,
+    /// A first-contact query: the more deeply overlapping child pair first.
+    first: bool,
+    /// Where the descent starts (the roots, or a recorded cut), and where it
+    /// reports the cut it ends on.
+    start: &'q [(u32, u32)],
+    stack: &'q mut Vec<(u32, u32)>,
+    nv: &'q mut u64,
+    cut: &'q mut C,
+    leaf: L,
+}
+
+impl<BV, C, L> Descent<BV> for Traversal<'_, BV, C, L>
+where
+    BV: BoundingVolume,
+    C: Terminal,
+    L: FnMut(&dyn Fn(u32) -> Vec3, usize, usize) -> bool,
+{
+    /// Exact volumes for subtrees of at most 4 triangles under `Auto` and
+    /// `Conservative` alike (W5, k-DOP18: as few volume and triangle tests as
+    /// the full refit; `ExactLeaves`).
+    #[inline(always)]
+    fn moved(rotation: RotationUpdate) -> Moved {
+        match rotation {
+            RotationUpdate::Refit => Moved::Refit,
+            RotationUpdate::Auto | RotationUpdate::Conservative => Moved::Exact { below: 4 },
+        }
+    }
+
+    /// Whether the leaf test stopped the descent.
+    #[inline]
+    fn descend(mut self, src: &mut impl LowerBounds<BV>, corner: &impl Fn(u32) -> Vec3) -> bool {
+        let leaf = |x, y| (self.leaf)(corner, x, y);
+        let (a, b, start, stack, nv, cut) =
+            (self.a, self.b, self.start, self.stack, self.nv, self.cut);
+        if self.first {
+            traverse::<BV, true>(a, src, b, start, stack, nv, cut, leaf)
+        } else {
+            traverse::<BV, false>(a, src, b, start, stack, nv, cut, leaf)
+        }
     }
 }

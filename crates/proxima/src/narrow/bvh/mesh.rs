@@ -1,14 +1,15 @@
 //! [`Mesh`]: a triangle mesh that owns its trees, the narrow phase's main type.
 //!
 //! Its queries are found by name: collisions in `collide.rs` ([`Mesh::collide`]),
-//! batches of rays in `par.rs`; construction, deformation and single ray casts
-//! here. Loading from a file is [`Mesh::load`], in [`io`](crate::io).
+//! distances in `narrow/distance/` ([`Mesh::distance`], [`Mesh::closest_point`],
+//! [`Mesh::contains_point`]), batches of rays in `par.rs`; construction,
+//! deformation and single ray casts here. Loading from a file is [`Mesh::load`], in [`io`](crate::io).
 
 use super::options::BuildOptions;
 use super::ray_tree::RayBvh;
 use super::tree::Bvh;
 use crate::geom::{Aabb, Ray, Segment, Sphere};
-use crate::narrow::bv::{BoundingVolume, Kdop18};
+use crate::narrow::bv::{enclosing_radius, BoundingVolume, Kdop18};
 use crate::narrow::ray_triangle::TriangleHit;
 use crate::narrow::TriMesh;
 use crate::Result;
@@ -32,7 +33,11 @@ use std::sync::OnceLock;
 ///   pose is the same sphere moved by that pose (what a broad phase stores).
 ///
 /// Queries: [`Mesh::collide`] / [`Mesh::collide_first`] against another mesh
-/// (with a [`Collider`](crate::narrow::Collider) for a loop of them),
+/// (with a [`Collider`](crate::narrow::Collider) for a loop of them);
+/// [`Mesh::distance`] / [`Mesh::within`] / [`Mesh::pairs_within`] against
+/// another mesh and [`Mesh::closest_point`] / [`Mesh::contains_point`] /
+/// [`Mesh::sphere_distance`] / [`Mesh::sphere_overlaps`] (with a
+/// [`Proximity`](crate::narrow::Proximity) for a loop of them);
 /// [`Mesh::cast_ray`] / [`Mesh::intersects_ray`] / [`Mesh::cast_segment`], and
 /// `Mesh::cast_rays_par` (feature `parallel`). [`Mesh::set_vertices`] deforms
 /// it, refitting both trees.
@@ -160,7 +165,7 @@ impl<BV: BoundingVolume> Mesh<BV> {
 }
 
 /// The box of every triangle corner, and the sphere around its centre (radius
-/// computed in `f64`, widened far beyond that rounding, rounded up to `f32`).
+/// from [`enclosing_radius`]: exact containment).
 fn bounds(mesh: &TriMesh) -> (Aabb, Sphere) {
     let corners = || {
         mesh.triangles()
@@ -170,15 +175,7 @@ fn bounds(mesh: &TriMesh) -> (Aabb, Sphere) {
     };
     let aabb = corners().fold(Aabb::EMPTY, |b, p| Aabb::new(b.min.min(p), b.max.max(p)));
     let c = aabb.center();
-    let r2 = corners()
-        .map(|p| (p.as_dvec3() - c.as_dvec3()).length_squared())
-        .fold(0.0f64, f64::max);
-    let r = r2.sqrt() * (1.0 + 1e-12);
-    let mut radius = r as f32;
-    if (radius as f64) < r {
-        radius = f32::from_bits(radius.to_bits() + 1);
-    }
-    (aabb, Sphere::new(c, radius))
+    (aabb, Sphere::new(c, enclosing_radius(c, corners())))
 }
 
 #[cfg(test)]

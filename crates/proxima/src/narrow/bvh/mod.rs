@@ -10,6 +10,9 @@
 //! - `refit.rs`: bottom-up refit for deformed vertices, and the exact world-frame
 //!   refit of a rotated tree (the source's rotation update, [sources: bvh-rotate]);
 //! - `traverse.rs`: the simultaneous descent of two trees [sources: bvh-traverse];
+//! - `moving.rs`: the moving tree's volumes in a query of two posed meshes
+//!   (rounding slack, the source of the moved volumes), shared by collision
+//!   and the distance queries;
 //! - `collide.rs`: mesh–mesh collision of two posed meshes with the cost counters
 //!   ([`Mesh::collide`], [`Collider`]);
 //! - `tri_cache.rs`: the per-query cache of prepared triangles;
@@ -22,6 +25,7 @@
 mod build;
 mod collide;
 mod mesh;
+pub(crate) mod moving;
 mod options;
 #[cfg(feature = "parallel")]
 mod par;
@@ -31,11 +35,12 @@ mod ray_tree;
 mod refit;
 mod sphere_query;
 mod stack;
-mod traverse;
+pub(crate) mod traverse;
 mod tree;
-mod tri_cache;
+pub(crate) mod tri_cache;
 mod validate;
 
+pub(crate) use collide::pose_deviation;
 pub use collide::{check_pose, Collider, Contacts, CostCounters, FirstContact, RotationUpdate};
 // For the collision world: relative poses of two checked poses, and traversal cuts.
 pub(crate) use collide::rotation_deviation;

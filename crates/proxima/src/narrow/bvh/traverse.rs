@@ -68,7 +68,7 @@ pub(crate) struct Lazy<'a, BV> {
 
 impl<BV: BoundingVolume> Lazy<'_, BV> {
     #[inline]
-    fn get(&mut self, i: usize) -> &BV {
+    pub(crate) fn get(&mut self, i: usize) -> &BV {
         if !self.cache.is_set(i) {
             self.updates += 1;
         }
@@ -93,14 +93,10 @@ impl<BV: BoundingVolume> VolumeSource<BV> for Lazy<'_, BV> {
     }
 }
 
-/// Subtrees of at most this many triangles get exact moved volumes in
-/// [`ExactLeaves`].
-const EXACT_BELOW: u32 = 4;
-
 /// [`Lazy`] with exact volumes near the leaves: a leaf's volume is fitted to its
 /// triangles' posed corners (`pose.transform_point3`, the `f32` points the
 /// triangle tests see), an internal node with a small subtree (at most
-/// [`EXACT_BELOW`] triangles) merges its children's, a larger one takes the
+/// `below` triangles: the query's choice) merges its children's, a larger one takes the
 /// conservative [`BoundingVolume::transformed`] bound; all enlarged by the slack
 /// and computed on first use (one node update each).
 ///
@@ -116,11 +112,13 @@ pub(crate) struct ExactLeaves<'a, BV> {
     pub vertices: &'a [Vec3],
     /// Triangles below each node of the moving tree (`Bvh::subtree`).
     pub sizes: &'a [u32],
+    /// Subtrees of at most this many triangles get exact volumes.
+    pub below: u32,
 }
 
 impl<BV: BoundingVolume> ExactLeaves<'_, BV> {
     #[inline]
-    fn get(&mut self, i: usize) -> &BV {
+    pub(crate) fn get(&mut self, i: usize) -> &BV {
         if !self.lazy.cache.is_set(i) {
             let bv = self.exact_or_transformed(i);
             self.lazy.updates += 1;
@@ -144,7 +142,7 @@ impl<BV: BoundingVolume> ExactLeaves<'_, BV> {
             }
             return bv.inflated(self.lazy.slack);
         }
-        if self.sizes[i] > EXACT_BELOW {
+        if self.sizes[i] > self.below {
             return n.bv.transformed(&self.lazy.pose).inflated(self.lazy.slack);
         }
         // A small subtree: the merge of the children's exact volumes (each

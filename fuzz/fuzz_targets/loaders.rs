@@ -12,7 +12,9 @@ use proxima::narrow::{Kdop18, Mesh, TriMesh};
 
 fn trees(mesh: TriMesh) {
     let m = Mesh::<Kdop18>::from_trimesh(mesh, Default::default()).expect("default options");
-    m.bvh().validate(m.trimesh()).expect("a fresh tree is valid");
+    m.bvh()
+        .validate(m.trimesh())
+        .expect("a fresh tree is valid");
     let (b, s) = (m.aabb(), m.bounding_sphere());
     for &v in m.trimesh().triangles().iter().flatten() {
         let p = m.trimesh().vertices()[v as usize];
@@ -20,7 +22,9 @@ fn trees(mesh: TriMesh) {
         assert!(p.as_dvec3().distance(s.center.as_dvec3()) <= s.radius as f64);
     }
     // Every triangle touches itself (closed sets, degenerate ones too).
-    let first = m.collide_first(&Affine3A::IDENTITY, &m).expect("identity pose");
+    let first = m
+        .collide_first(&Affine3A::IDENTITY, &m)
+        .expect("identity pose");
     assert!(first.pair.is_some());
     // A ray down through the box: the cast and the any-hit test agree.
     let ray = Ray::new(b.center() + Vec3::Z, -Vec3::Z);

@@ -7,8 +7,8 @@
 #![no_main]
 
 use proxima::glam::Vec3;
-use proxima_harness::tri_tri as reference;
 use proxima::narrow::{triangles_intersect, PreparedTriangle};
+use proxima_harness::tri_tri as reference;
 
 /// Coordinates on a small integer grid (many exact touches and coplanar cases)
 /// or raw finite floats.

@@ -7,10 +7,13 @@
 
 mod collide;
 mod demo;
+mod demo_world;
 mod draw;
 mod pictures;
 mod render;
 mod replay;
+mod world;
+mod world_picture;
 
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};
@@ -52,6 +55,10 @@ enum Command {
     /// Pictures: the partitions of a trace's end state, or two meshes and their
     /// intersecting triangles (`--collide A B [--pose ...]`).
     Render(render::Args),
+    /// Run a world trace (meshes at poses, contacts, rays, spheres) on the
+    /// collision world: `world TRACE [--index NAME] [--bv NAME] [--first]
+    /// [--check] [--time]`.
+    World(world::Args),
 }
 
 /// The last line of defence: a panic (a bug: bad input is reported as an error
@@ -104,5 +111,6 @@ fn main() -> ExitCode {
         Some(Command::Replay(args)) => replay::main(&args),
         Some(Command::Collide { args }) => ExitCode::from(collide::main(&args) as u8),
         Some(Command::Render(args)) => render::main(&args),
+        Some(Command::World(args)) => world::main(&args),
     }
 }

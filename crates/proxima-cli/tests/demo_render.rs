@@ -61,6 +61,10 @@ fn demo_prints_a_table_with_equal_pairs_and_writes_pngs() {
         "1500",
         "--frames",
         "3",
+        "--world-objects",
+        "30",
+        "--world-frames",
+        "3",
         "--out",
         dir.to_str().unwrap(),
     ]);
@@ -89,10 +93,28 @@ fn demo_prints_a_table_with_equal_pairs_and_writes_pngs() {
     assert!(pairs[0].parse::<f64>().unwrap() > 0.0);
     assert!(o.stdout.contains("<- fastest"));
     assert!(o.stdout.contains("exactly the brute-force pair count"));
-    // Not a terminal: one plain progress line per index on stderr.
-    assert_eq!(o.stderr.lines().count(), NAMES.len(), "{}", o.stderr);
+    // The world scene's table, checked against the brute-force world.
+    assert!(
+        o.stdout.contains("world: 30 meshes (bunny.obj"),
+        "{}",
+        o.stdout
+    );
+    for stage in ["poses ", "contacts ", "rays ", "cull "] {
+        assert!(
+            o.stdout.lines().any(|l| l.starts_with(stage)),
+            "{stage}: {}",
+            o.stdout
+        );
+    }
+    assert!(o
+        .stdout
+        .contains("checked frames 1, 2, 3: the brute-force world"));
+    // Not a terminal: one plain progress line per index and one for the world.
+    assert_eq!(o.stderr.lines().count(), NAMES.len() + 1, "{}", o.stderr);
+    assert!(o.stderr.lines().last().unwrap().contains("world: 3 frames"));
     let paths = printed_paths(&o.stdout);
-    assert_eq!(paths.len(), 3, "{}", o.stdout);
+    assert_eq!(paths.len(), 4, "{}", o.stdout);
+    assert!(paths[3].ends_with("world.png"));
     for p in &paths {
         assert!(p.starts_with(&dir) && p.extension().unwrap() == "png");
         check_png(p);
@@ -114,6 +136,10 @@ fn demo_json_parses_for_each_scene() {
             "--no-pictures",
             "--seed",
             "3",
+            "--world-objects",
+            if scene == "uniform" { "20" } else { "0" },
+            "--world-frames",
+            "2",
         ]);
         assert_eq!(o.code, 0, "{}", o.stderr);
         let v: serde_json::Value = serde_json::from_str(&o.stdout).expect("one JSON object");
@@ -129,6 +155,16 @@ fn demo_json_parses_for_each_scene() {
         }
         assert!(v["pictures"].as_array().unwrap().is_empty());
         assert!(NAMES.contains(&v["fastest"].as_str().unwrap()));
+        if scene == "uniform" {
+            let w = &v["world"];
+            assert_eq!(w["objects"], 20);
+            assert_eq!(w["frames"], 2);
+            assert_eq!(w["checked_frames"], serde_json::json!([1, 2]));
+            assert!(w["contacts_ms_per_frame"].as_f64().unwrap() >= 0.0);
+            assert!(w["picture"].is_null());
+        } else {
+            assert!(v["world"].is_null());
+        }
     }
 }
 
@@ -142,6 +178,10 @@ fn no_command_runs_the_demo_with_its_options_and_one_index() {
         "2",
         "--index",
         "octree",
+        "--world-objects",
+        "8",
+        "--world-frames",
+        "1",
         "--svg",
         "--out",
         dir.to_str().unwrap(),
@@ -152,7 +192,7 @@ fn no_command_runs_the_demo_with_its_options_and_one_index() {
     assert!(o.stdout.lines().any(|l| l.starts_with("brute ")));
     assert!(!o.stdout.lines().any(|l| l.starts_with("grid2d ")));
     let paths = printed_paths(&o.stdout);
-    assert_eq!(paths.len(), 3);
+    assert_eq!(paths.len(), 4);
     for p in paths {
         let svg = std::fs::read_to_string(&p).unwrap();
         assert!(
@@ -216,6 +256,18 @@ fn bad_flags_and_missing_files_give_one_line_and_exit_2() {
         vec!["demo", "--frames", "0"],
         vec!["demo", "--scene", "cube"],
         vec!["demo", "--index", "rtree"],
+        vec!["demo", "--world-objects", "100000"],
+        vec!["demo", "--world-frames", "0"],
+        vec![
+            "demo",
+            "--objects",
+            "10",
+            "--frames",
+            "1",
+            "--no-pictures",
+            "--data",
+            "/no/such/dir",
+        ],
         vec!["render"],
         vec!["render", "/no/such.trace"],
         vec!["render", "--collide", &rob, &missing],

@@ -15,19 +15,12 @@
 //! | [`poses`] | the pose-file format (12 numbers a line) | `proxima collide`, `proxima render`, W5 bench |
 //! | [`oracle`] | long random sequences on one index against brute force; [`oracle::make_index`] | `tests/oracle`, `tests/loose_kd*.rs`, `tests/extreme.rs` |
 //! | [`tri_tri`] | the exact triangle–triangle reference | `tests/tri_tri`, `tri_tri` fuzz target |
+//! | [`world_trace`] | the world trace of `proxima world` [sources: world-trace] | CLI, demo, `world` fuzz target |
+//! | [`world_replay`] | a world trace run on a `World` with any index and BV; answers compared | CLI, demo, `world` fuzz target |
+//! | [`world_oracle`] | the brute-force world (every object pair, every triangle pair) | CLI `--check`, demo, `world` fuzz target |
 //!
 //! Everything checks by panicking (`assert!`) or by returning a one-line error
 //! a command prints: the callers are tests, fuzz targets and tools.
-//!
-//! # Where the collision world's pieces go (issue #13)
-//!
-//! Beside each broad-phase piece, its world counterpart: a `world_trace` module
-//! parsing `proxima world`'s format [sources: world-trace] with the same
-//! [`lex`] helpers (a `Line`, `expect_fields`, `numbers`, `ParseError`), a
-//! `world_replay` engine in the shape of [`replay`] (a `Run` of answers per
-//! configuration, the first disagreement with the brute-force world), and a
-//! `world_oracle` with the brute-force world (every object pair, every triangle
-//! pair, [`tri_tri`] available as the exact reference) driven like [`oracle::run`].
 //! New trace lines of issue #14 slot into [`trace`] as described there.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -41,3 +34,6 @@ pub mod replay;
 pub mod trace;
 pub mod tri_tri;
 pub mod workloads;
+pub mod world_oracle;
+pub mod world_replay;
+pub mod world_trace;

@@ -252,6 +252,25 @@ impl<V> Arena<V> {
             })
     }
 
+    /// Live `(handle, value)` pairs in slot order, the values mutably.
+    pub fn iter_mut(&mut self) -> impl Iterator<Item = (Handle, &mut V)> + '_ {
+        let tag = self.tag;
+        self.slots
+            .iter_mut()
+            .enumerate()
+            .filter_map(move |(i, s)| match &mut s.entry {
+                Entry::Occupied(v) => Some((
+                    Handle {
+                        tag,
+                        index: i as u32,
+                        generation: s.generation,
+                    },
+                    v,
+                )),
+                Entry::Vacant { .. } => None,
+            })
+    }
+
     /// Bytes of heap memory held (capacity, not just length).
     pub fn heap_bytes(&self) -> usize {
         self.slots.capacity() * std::mem::size_of::<Slot<V>>()

@@ -15,6 +15,10 @@
 //!   OBB, AABB or sphere BVH for exact mesh–mesh collision down to the closed
 //!   triangle–triangle test, and a 4-wide BVH for exact ray casts; the generic
 //!   [`narrow::Bvh`] below it for experiments with the source's choices [sources: bvh].
+//! - [`world`]: the collision world, [`world::World`]: shared mesh and ball
+//!   [`world::Shape`]s at rigid poses over a broad-phase index chosen at run
+//!   time, with contacts (temporal coherence, ignored pairs, filters), ray casts,
+//!   sphere queries and culling [sources: world].
 //! - [`io`]: OBJ, STL and PLY loaders into a [`narrow::TriMesh`], or with
 //!   [`narrow::Mesh::load`] straight into a mesh with its trees.
 //!
@@ -30,6 +34,7 @@ pub mod geom;
 mod handle;
 pub mod io;
 pub mod narrow;
+pub mod world;
 
 pub use error::{Error, FileLocation, IoError, Result};
 pub use glam;

@@ -3,7 +3,7 @@
 //!
 //! Every answer is exact and closed: a peer's own traversal yields candidates
 //! (AABB, ray or point-radius hits), and the same tests of `proxima::geom::overlap`
-//! (through [`Selection::selects`]) filter them, so hit counts are comparable.
+//! (through `Selection::selects`) filter them, so hit counts are comparable.
 
 use super::queries::{Batches, QueryKind};
 use proxima::broad::{par_query_counts, AnyIndex, Query, SpatialIndex};

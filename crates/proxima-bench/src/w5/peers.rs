@@ -87,7 +87,7 @@ pub struct PeerRun {
     /// Hit per pose.
     pub hits: Vec<bool>,
     /// Poses whose answer differs from ours only by triangle pairs within the
-    /// library's touching tolerance (checked: see [`check_against`]).
+    /// library's touching tolerance (checked: see `check_against`).
     pub tolerance_poses: usize,
     /// Extra pairs the peer reports on those poses.
     pub tolerance_pairs: u64,

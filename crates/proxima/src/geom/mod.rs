@@ -5,7 +5,7 @@
 //! two spheres at distance exactly `r1 + r2` overlap.
 
 mod aabb;
-mod exact;
+pub(crate) mod exact;
 mod frustum;
 pub mod overlap;
 mod plane;

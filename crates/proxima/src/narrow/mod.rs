@@ -23,16 +23,20 @@ pub(crate) mod predicates;
 mod prepared;
 mod ray_triangle;
 mod segment;
+mod sphere_triangle;
 mod tri_tri;
 mod trimesh;
 
 pub use bv::{BoundingVolume, Kdop, Kdop14, Kdop18, Kdop26, Obb};
+// For the collision world (crate::world).
 pub use bvh::{
     check_pose, BuildOptions, Bvh, Collider, Contacts, CostCounters, FirstContact, Mesh, Node,
     RayBvh, RotationUpdate, SplitRule,
 };
+pub(crate) use bvh::{rotation_deviation, CutRecorder};
 pub use prepared::PreparedTriangle;
 pub use ray_triangle::{ray_triangle, TriangleHit};
 pub use segment::{segment_triangle_intersect, segments_intersect};
+pub use sphere_triangle::sphere_triangle;
 pub use tri_tri::triangles_intersect;
 pub use trimesh::TriMesh;

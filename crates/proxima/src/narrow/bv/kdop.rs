@@ -266,7 +266,7 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
     /// axis `u`, the support of a box of centre `c` and half-extents `e` rotated by
     /// `R` is `u·(Rc + t) ± |Rᵀu|·e`. O(K), conservative.
     ///
-    /// `Rᵀu` for the integer axes is a sum of rows of `R` ([`rotated_axis`]): no
+    /// `Rᵀu` for the integer axes is a sum of rows of `R` (`rotated_axis`): no
     /// matrix product per slab (this runs once per visited node of a rotated
     /// moving tree).
     #[inline]

@@ -3,7 +3,7 @@
 //! counters of [sources: bvh-cost].
 
 use super::mesh::Mesh;
-use super::traverse::{traverse, ExactLeaves, Lazy, Local, Precomputed};
+use super::traverse::{traverse, ExactLeaves, Lazy, Local, Precomputed, Terminal};
 use super::tri_cache::{QueryCache, TriangleCache};
 use crate::narrow::bv::{slack_for, BoundingVolume};
 use crate::narrow::PreparedTriangle;
@@ -115,17 +115,8 @@ pub fn check_pose(pose: &Affine3A) -> Result<()> {
 
 /// Checks a pose and returns the deviation of its matrix from a rotation.
 pub(crate) fn pose_deviation(pose: &Affine3A) -> Result<f32> {
-    if !pose.matrix3.is_finite() || !pose.translation.is_finite() {
-        return Err(Error::InvalidPose("pose is not finite".into()));
-    }
+    let dev = rotation_deviation(pose)?;
     let m = pose.matrix3;
-    let d = m.transpose() * m - Mat3A::IDENTITY;
-    let dev = d
-        .x_axis
-        .abs()
-        .max(d.y_axis.abs())
-        .max(d.z_axis.abs())
-        .max_element();
     if dev.is_nan() || dev > MAX_POSE_DEVIATION || m.determinant() <= 0.0 {
         return Err(Error::InvalidPose(format!(
             "matrix is not a rotation (|RᵀR - I| = {dev}, det = {})",
@@ -133,6 +124,23 @@ pub(crate) fn pose_deviation(pose: &Affine3A) -> Result<f32> {
         )));
     }
     Ok(dev)
+}
+
+/// The largest entry of `|RᵀR - I|` of a finite pose, with no limit (the
+/// collision world composes two checked poses, whose product may deviate up to
+/// about twice [`check_pose`]'s limit; the rounding slack grows with it).
+/// Fails only on a non-finite pose.
+pub(crate) fn rotation_deviation(pose: &Affine3A) -> Result<f32> {
+    if !pose.matrix3.is_finite() || !pose.translation.is_finite() {
+        return Err(Error::InvalidPose("pose is not finite".into()));
+    }
+    let m = pose.matrix3;
+    let d = m.transpose() * m - Mat3A::IDENTITY;
+    Ok(d.x_axis
+        .abs()
+        .max(d.y_axis.abs())
+        .max(d.z_axis.abs())
+        .max_element())
 }
 
 impl<BV: BoundingVolume> Collider<BV> {
@@ -211,6 +219,32 @@ impl<BV: BoundingVolume> Collider<BV> {
         custom: Option<&TriangleTest>,
     ) -> Result<CostCounters> {
         let dev = pose_deviation(pose)?;
+        Ok(self
+            .run_from(a, pose, dev, b, first, out, custom, &[(0, 0)], &mut ())
+            .0)
+    }
+
+    /// The query of [`Collider::all_pairs`] (or, with `first`, of
+    /// [`Collider::first_contact`]) for a pose already checked, whose matrix
+    /// deviates from a rotation by `dev` (any finite amount: the rounding slack
+    /// grows with it), starting from the node pairs `start` (the roots, or a cut
+    /// an earlier traversal reported to its `cut`: the same triangle pairs are
+    /// found, possibly in another order) and reporting where it ends to `cut`.
+    /// Appends the intersecting triangle pairs to `out`; returns the counters and
+    /// whether it stopped early (then `cut` saw only part of the cut).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn run_from(
+        &mut self,
+        a: &Mesh<BV>,
+        pose: &Affine3A,
+        dev: f32,
+        b: &Mesh<BV>,
+        first: bool,
+        out: &mut Vec<(u32, u32)>,
+        custom: Option<&TriangleTest>,
+        start: &[(u32, u32)],
+        cut: &mut impl Terminal,
+    ) -> (CostCounters, bool) {
         // A mesh's tree always matches its geometry: nothing else to check.
         let (ta, ma) = (a.bvh(), a.trimesh());
         let (tb, mb) = (b.bvh(), b.trimesh());
@@ -261,15 +295,17 @@ impl<BV: BoundingVolume> Collider<BV> {
         macro_rules! go {
             ($src:expr, $corner:expr) => {
                 if first {
-                    traverse::<BV, true>(ta, $src, tb, stack, &mut c.nv, |x, y| leaf($corner, x, y))
+                    traverse::<BV, true>(ta, $src, tb, start, stack, &mut c.nv, cut, |x, y| {
+                        leaf($corner, x, y)
+                    })
                 } else {
-                    traverse::<BV, false>(ta, $src, tb, stack, &mut c.nv, |x, y| {
+                    traverse::<BV, false>(ta, $src, tb, start, stack, &mut c.nv, cut, |x, y| {
                         leaf($corner, x, y)
                     })
                 }
             };
         }
-        if BV::AXIS_ALIGNED && rotated {
+        let stopped = if BV::AXIS_ALIGNED && rotated {
             let update = match *rotation {
                 RotationUpdate::Auto => RotationUpdate::Conservative,
                 r => r,
@@ -281,7 +317,7 @@ impl<BV: BoundingVolume> Collider<BV> {
                     c.nu = ta.world_volumes(world_vertices, slack, world);
                     let wv: &[Vec3] = world_vertices;
                     let corner = |v: u32| wv[v as usize];
-                    go!(&mut Precomputed(world), &corner);
+                    go!(&mut Precomputed(world), &corner)
                 }
                 _ => {
                     cache.begin(ta.nodes.len(), ta.nodes[0].bv);
@@ -297,8 +333,9 @@ impl<BV: BoundingVolume> Collider<BV> {
                         vertices: va,
                         sizes: &ta.subtree,
                     };
-                    go!(&mut src, &moved);
+                    let stopped = go!(&mut src, &moved);
                     c.nu = src.lazy.updates;
+                    stopped
                 }
             }
         } else {
@@ -306,9 +343,9 @@ impl<BV: BoundingVolume> Collider<BV> {
                 nodes: &ta.nodes,
                 motion: BV::motion(pose, slack),
             };
-            go!(&mut src, &moved);
-        }
+            go!(&mut src, &moved)
+        };
         c.np = np;
-        Ok(c)
+        (c, stopped)
     }
 }

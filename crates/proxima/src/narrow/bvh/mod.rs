@@ -16,6 +16,7 @@
 //! - `ray.rs`: ray and segment casts on a [`Bvh`]; `ray_tree.rs` + `ray_cast.rs`:
 //!   [`RayBvh`], the same casts on a layout made for rays only; `stack.rs`: their
 //!   traversal stack; `par.rs`: parallel batches of casts (feature `parallel`);
+//! - `sphere_query.rs`: the triangles within a ball ([`Mesh::triangles_in_sphere`]);
 //! - `validate.rs`: the structural invariants.
 
 mod build;
@@ -28,6 +29,7 @@ mod ray;
 mod ray_cast;
 mod ray_tree;
 mod refit;
+mod sphere_query;
 mod stack;
 mod traverse;
 mod tree;
@@ -35,7 +37,10 @@ mod tri_cache;
 mod validate;
 
 pub use collide::{check_pose, Collider, Contacts, CostCounters, FirstContact, RotationUpdate};
+// For the collision world: relative poses of two checked poses, and traversal cuts.
+pub(crate) use collide::rotation_deviation;
 pub use mesh::Mesh;
 pub use options::{BuildOptions, SplitRule};
 pub use ray_tree::RayBvh;
+pub(crate) use traverse::CutRecorder;
 pub use tree::{Bvh, Node};

@@ -170,12 +170,58 @@ impl<BV: BoundingVolume> VolumeSource<BV> for ExactLeaves<'_, BV> {
     }
 }
 
-/// Descends both trees from their roots: a pair of nodes whose volumes overlap is
-/// split on the side that is not a leaf, or on the larger volume when neither is
-/// ([sources: bvh-traverse], with the usual "descend the larger" refinement); a pair of
-/// overlapping leaves goes to `leaf(a_node, b_node)`, which returns true to stop.
-/// Each pair of leaves is reached at most once, so each triangle pair is tested at
-/// most once. Counts volume tests in `nv`. Returns true if stopped early.
+/// Where a traversal ended: every node pair it did not split (a disjoint pair, or
+/// a pair of overlapping leaves), in the order met. These pairs form a cut of the
+/// two trees' pair tree: their leaf products partition all leaf pairs, so a later
+/// traversal may start from them instead of the roots and reach the same
+/// triangle pairs (the collision world's coherence, [sources: bvh-next]).
+pub(crate) trait Terminal {
+    /// Records a pair the traversal did not split.
+    fn reached(&mut self, ia: u32, ib: u32);
+}
+
+/// Records nothing: a plain traversal.
+impl Terminal for () {
+    #[inline(always)]
+    fn reached(&mut self, _: u32, _: u32) {}
+}
+
+/// Records the cut into `out` while it has at most `cap` pairs past `base` (the
+/// length of `out` when recording began); beyond that it stops and sets `full`
+/// (the caller drops the partial cut).
+#[derive(Debug)]
+pub(crate) struct CutRecorder<'a> {
+    pub out: &'a mut Vec<(u32, u32)>,
+    pub base: usize,
+    pub cap: usize,
+    pub full: bool,
+}
+
+impl Terminal for CutRecorder<'_> {
+    #[inline]
+    fn reached(&mut self, ia: u32, ib: u32) {
+        if self.full {
+            return;
+        }
+        if self.out.len() - self.base >= self.cap {
+            self.full = true;
+        } else {
+            self.out.push((ia, ib));
+        }
+    }
+}
+
+/// Descends both trees from the node pairs `start` (the roots `(0, 0)`, or a cut
+/// recorded by an earlier traversal: see [`Terminal`]): a pair of nodes whose
+/// volumes overlap is split on the side that is not a leaf, or on the larger
+/// volume when neither is ([sources: bvh-traverse], with the usual "descend the
+/// larger" refinement); a pair of overlapping leaves goes to
+/// `leaf(a_node, b_node)`, which returns true to stop. Pairs not split are
+/// reported to `cut`. Each pair of leaves is reached at most once, so each
+/// triangle pair is tested at most once. The roots are tested first, which ends
+/// the traversal when they are disjoint (one test instead of one per pair of a
+/// cut). Counts volume tests in `nv`. Returns true if stopped early (then `cut`
+/// saw only part of the cut).
 ///
 /// The two child pairs of a split are tested before anything is pushed: only
 /// overlapping pairs go on the stack, and the descent continues with the first
@@ -183,26 +229,47 @@ impl<BV: BoundingVolume> VolumeSource<BV> for ExactLeaves<'_, BV> {
 /// first-contact query), the child pair whose volumes overlap more deeply
 /// ([`BoundingVolume::overlap_depth`]) comes first, else the left one: the
 /// same pairs are visited either way until the leaf callback stops the descent.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn traverse<BV: BoundingVolume, const DEEPEST_FIRST: bool>(
     a: &Bvh<BV>,
     src: &mut impl VolumeSource<BV>,
     b: &Bvh<BV>,
+    start: &[(u32, u32)],
     stack: &mut Vec<(u32, u32)>,
     nv: &mut u64,
+    cut: &mut impl Terminal,
     mut leaf: impl FnMut(usize, usize) -> bool,
 ) -> bool {
     stack.clear();
     *nv += 1;
     if !src.overlaps(0, &b.nodes[0].bv) {
+        cut.reached(0, 0);
         return false;
     }
     // The current pair: its volumes overlap.
     let (mut ia, mut ib) = (0u32, 0u32);
+    if start != [(0, 0)] {
+        // A cut: its overlapping pairs go on the stack (the first on top), the
+        // others are already part of the new cut.
+        for &(ja, jb) in start.iter().rev() {
+            *nv += 1;
+            if src.overlaps(ja as usize, &b.nodes[jb as usize].bv) {
+                stack.push((ja, jb));
+            } else {
+                cut.reached(ja, jb);
+            }
+        }
+        match stack.pop() {
+            Some(next) => (ia, ib) = next,
+            None => return false,
+        }
+    }
     loop {
         let na = &a.nodes[ia as usize];
         let nb = &b.nodes[ib as usize];
         let descend_a = match (na.is_leaf(), nb.is_leaf()) {
             (true, true) => {
+                cut.reached(ia, ib);
                 if leaf(ia as usize, ib as usize) {
                     return true;
                 }
@@ -257,12 +324,22 @@ pub(crate) fn traverse<BV: BoundingVolume, const DEEPEST_FIRST: bool>(
                 stack.push(second);
                 first
             }
-            (true, false) => x,
-            (false, true) => y,
-            (false, false) => match stack.pop() {
-                Some(next) => next,
-                None => return false,
-            },
+            (true, false) => {
+                cut.reached(y.0, y.1);
+                x
+            }
+            (false, true) => {
+                cut.reached(x.0, x.1);
+                y
+            }
+            (false, false) => {
+                cut.reached(x.0, x.1);
+                cut.reached(y.0, y.1);
+                match stack.pop() {
+                    Some(next) => next,
+                    None => return false,
+                }
+            }
         };
     }
 }

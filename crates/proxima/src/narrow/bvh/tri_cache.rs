@@ -35,12 +35,16 @@ impl<T: Copy> QueryCache<T> {
     /// initializes new storage (never read before being overwritten).
     pub(crate) fn begin(&mut self, n: usize, fill: T) {
         self.generation = self.generation.wrapping_add(1);
-        if self.generation == 0 || self.stamp.len() != n {
+        if self.generation == 0 {
             self.stamp.clear();
-            self.stamp.resize(n, 0);
-            self.data.clear();
-            self.data.resize(n, fill);
             self.generation = 1;
+        }
+        // Grow only: a collider that alternates between meshes of different
+        // sizes (a collision world's pairs) keeps its storage. Entries past `n`
+        // are never read in this query; new ones carry stamp 0, never current.
+        if self.stamp.len() < n {
+            self.stamp.resize(n, 0);
+            self.data.resize(n, fill);
         }
     }
 

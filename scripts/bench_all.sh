@@ -2,7 +2,8 @@
 # Regenerates docs/bench/* (the raw outputs behind BENCHMARKS.md) from the
 # release bench binary. Run from the repo root after
 # `cargo build --release -p proxima-bench` (and `scripts/peers.sh` for the C++
-# peers of W5); takes about 8 minutes on 2 cores.
+# peers of W5); takes about 12 minutes on 2 cores. Every peer runs in each of
+# its modes (one row each, the `mode` field); ratios are over the fastest.
 set -e
 B=./target/release/proxima-bench
 D=docs/bench
@@ -11,6 +12,7 @@ $B w1 --n 10000  --frames 30 --json > $D/w1-10k.json 2>/dev/null
 $B w1 --n 100000 --frames 30 --json > $D/w1-100k.json 2>/dev/null
 $B w2 --n 100000 --frames 30 --json > $D/w2-100k.json 2>/dev/null
 $B w3 --n 100000 --frames 30 --json > $D/w3-100k.json 2>/dev/null
+$B w9 --n 100000 --frames 30 --json > $D/w9-100k.json 2>/dev/null
 uptime >> $D/load.txt
 for t in 1 2; do $B w1 --n 100000 --frames 30 --clock wall --threads $t --only LooseKdTree,UniformGrid3d,parry3d --json > $D/w1-100k-wall-t$t.json 2>/dev/null; done
 $B w4 > $D/w4.txt 2>/dev/null
@@ -29,10 +31,23 @@ $B w6 --json > $D/w6.json 2>/dev/null
 uptime >> $D/load.txt
 $B w1 --n 1000000 --frames 10 --json > $D/w1-1m.json 2>/dev/null
 uptime >> $D/load.txt
+# Issue #17 part 7: W1 1M pairs on 1 and 2 threads (wall clock; the pair search
+# runs in a pool of that size, the update on the calling thread). Compare the
+# pairs_ms_median of t2 with t1; meaningful only on a quiet machine (load.txt).
+for t in 1 2; do $B w1 --n 1000000 --frames 10 --clock wall --threads $t --only LooseKdTree,UniformGrid3d --json > $D/w1-1m-wall-t$t.json 2>/dev/null; done
+uptime >> $D/load.txt
+python3 - > $D/w1-1m-threads.txt <<'PY'
+import json
+t = {k: {r['structure']: r for r in json.load(open(f'docs/bench/w1-1m-wall-t{k}.json'))} for k in (1, 2)}
+print('W1 1M, wall clock: pairs ms/frame on 1 and 2 threads, speed-up (target >= 1.7x)')
+for name in t[1]:
+    a, b = t[1][name]['pairs_ms_median'], t[2][name]['pairs_ms_median']
+    print(f'{name:<14} {a:9.1f} {b:9.1f} {a / b:6.2f}x')
+PY
 python3 - <<'PY'
 import json
 rows=[]
-for f in ['w1-10k','w1-100k','w1-1m','w2-100k','w3-100k']:
+for f in ['w1-10k','w1-100k','w1-1m','w2-100k','w3-100k','w9-100k']:
     rows += [r for r in json.load(open(f'docs/bench/{f}.json')) if r['structure']!='BruteForce']
 json.dump(rows, open('/tmp/w1-w3-nobrute.json','w'))
 PY

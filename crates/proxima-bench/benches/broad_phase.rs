@@ -28,7 +28,7 @@ fn workload_group(c: &mut Criterion, kind: Kind, n: usize) {
         let mut w = Workload::new(kind, n, SEED);
         let mut s = entry.make(&w.scene());
         s.build(&w.spheres);
-        group.bench_function(BenchmarkId::from_parameter(entry.name), |b| {
+        group.bench_function(BenchmarkId::from_parameter(entry.label()), |b| {
             b.iter(|| {
                 w.step();
                 s.update(&w.spheres);

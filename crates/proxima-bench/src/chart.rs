@@ -68,11 +68,7 @@ pub fn panels(files: &[(String, String)], metric: &str) -> Result<Vec<Panel>, St
                 .collect::<Vec<_>>()
                 .join(" ");
             let bar = Bar {
-                label: obj
-                    .get("structure")
-                    .and_then(Value::as_str)
-                    .unwrap_or("?")
-                    .to_string(),
+                label: label(obj),
                 peer: obj.get("peer").and_then(Value::as_bool).unwrap_or(false),
                 value,
             };
@@ -89,6 +85,16 @@ pub fn panels(files: &[(String, String)], metric: &str) -> Result<Vec<Panel>, St
         return Err(format!("no row has a numeric {metric:?} field"));
     }
     Ok(out)
+}
+
+/// A bar's label: the structure, with its mode when the row has one (a peer
+/// run in several modes has one bar per mode).
+fn label(obj: &serde_json::Map<String, Value>) -> String {
+    let name = obj.get("structure").and_then(Value::as_str).unwrap_or("?");
+    match obj.get("mode").and_then(Value::as_str) {
+        Some(mode) if mode != "-" => format!("{name} ({mode})"),
+        _ => name.to_string(),
+    }
 }
 
 fn escape(s: &str) -> String {

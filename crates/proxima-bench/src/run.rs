@@ -108,6 +108,8 @@ impl PairLedger {
 pub struct Measurement {
     /// Structure name.
     pub name: &'static str,
+    /// The peer's mode ([`Entry::mode`]; `-` for Proxima's indices).
+    pub mode: &'static str,
     /// Whether this is a peer crate.
     pub peer: bool,
     /// Time to insert every object into the empty structure.
@@ -208,6 +210,7 @@ pub fn measure_threads(
     let ((), build) = clock.time(|| s.build(&w.spheres));
     let mut m = Measurement {
         name: entry.name,
+        mode: entry.mode,
         peer: entry.peer,
         build,
         update: Vec::with_capacity(frames),

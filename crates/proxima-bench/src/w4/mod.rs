@@ -24,6 +24,7 @@ pub mod rstar_peer;
 use crate::registry::QUADRATIC_LIMIT;
 use crate::run::{median, num, Clock};
 use engine::{Engine, Proxima};
+use parry3d::partitioning::BvhBuildStrategy;
 use proxima::broad::IndexKind;
 use proxima_harness::workloads::{cube_side, Kind, Scene, Workload};
 use queries::QueryKind;
@@ -111,9 +112,11 @@ pub fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     Ok(a)
 }
 
-/// One structure: name, whether it is a peer, and its bulk build.
+/// One structure: name, mode (how a peer is built: one entry per documented
+/// way, `-` for Proxima's indices), whether it is a peer, and its build.
 struct Entry {
     name: &'static str,
+    mode: &'static str,
     peer: bool,
     quadratic: bool,
     build: Build,
@@ -168,31 +171,56 @@ fn entries() -> Vec<Entry> {
     ]
     .map(|kind| Entry {
         name: kind.type_name(),
+        mode: crate::registry::NO_MODE,
         peer: false,
         quadratic: kind == IndexKind::Brute,
         build: Build::Index(kind),
     });
     let peers = [
+        // Every documented build of a peer is its own row; the ratios take the
+        // fastest (queries run on the tree each build makes).
         Entry {
             name: "parry3d",
+            mode: "binned",
             peer: true,
             quadratic: false,
-            build: Build::Peer(|s, _, _| Box::new(parry_peer::ParryQuery::build(s))),
+            build: Build::Peer(|s, _, _| {
+                Box::new(parry_peer::ParryQuery::build(s, BvhBuildStrategy::Binned))
+            }),
+        },
+        Entry {
+            name: "parry3d",
+            mode: "ploc",
+            peer: true,
+            quadratic: false,
+            build: Build::Peer(|s, _, _| {
+                Box::new(parry_peer::ParryQuery::build(s, BvhBuildStrategy::Ploc))
+            }),
         },
         Entry {
             name: "rstar",
+            mode: "bulk_load",
             peer: true,
             quadratic: false,
             build: Build::Peer(|s, _, _| Box::new(rstar_peer::RstarQuery::build(s))),
         },
         Entry {
+            name: "rstar",
+            mode: "insert",
+            peer: true,
+            quadratic: false,
+            build: Build::Peer(|s, _, _| Box::new(rstar_peer::RstarQuery::build_by_inserts(s))),
+        },
+        Entry {
             name: "kiddo",
+            mode: "immutable",
             peer: true,
             quadratic: false,
             build: Build::Peer(|s, _, _| Box::new(kiddo_peer::KiddoQuery::build(s))),
         },
         Entry {
             name: "bvh",
+            mode: "sah",
             peer: true,
             quadratic: false,
             build: Build::Peer(|s, _, _| Box::new(bvh_peer::BvhQuery::build(s))),
@@ -206,6 +234,8 @@ fn entries() -> Vec<Entry> {
 pub struct Row {
     /// Structure.
     pub name: &'static str,
+    /// How it was built (`-` for Proxima's indices).
+    pub mode: &'static str,
     /// A peer crate?
     pub peer: bool,
     /// Build time (once, shared by the kinds).
@@ -297,6 +327,7 @@ pub fn run(a: &Args) -> (Vec<(QueryKind, Vec<Row>)>, Vec<String>) {
         for (i, (e, engine, build)) in built.iter().enumerate() {
             out.push(Row {
                 name: e.name,
+                mode: e.mode,
                 peer: e.peer,
                 build: *build,
                 batch: engine.supports(*kind).then(|| median(&times[k][i])),
@@ -349,8 +380,9 @@ pub fn table(
         let _ = writeln!(out, "\n{} queries: {q} per batch", kind.name());
         let _ = writeln!(
             out,
-            "{:<14} {:>9} {:>10} {:>10} {:>12} {:>10} {:>12} {:>13}",
+            "{:<14} {:<10} {:>9} {:>10} {:>10} {:>12} {:>10} {:>12} {:>13}",
             "structure",
+            "mode",
             "build ms",
             "us/query",
             "Mq/s",
@@ -366,8 +398,9 @@ pub fn table(
                     let fmt = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.2}x"));
                     let _ = writeln!(
                         out,
-                        "{:<14} {:>9.1} {:>10.3} {:>10.3} {:>12} {:>10.1} {:>12} {:>13}",
+                        "{:<14} {:<10} {:>9.1} {:>10.3} {:>10.3} {:>12} {:>10.1} {:>12} {:>13}",
                         r.name,
+                        r.mode,
                         r.build.as_secs_f64() * 1e3,
                         us,
                         1.0 / us.max(1e-12),
@@ -380,8 +413,9 @@ pub fn table(
                 None => {
                     let _ = writeln!(
                         out,
-                        "{:<14} {:>9.1} {:>10} {:>10} {:>12} {:>10.1} {:>12}",
+                        "{:<14} {:<10} {:>9.1} {:>10} {:>10} {:>12} {:>10.1} {:>12}",
                         r.name,
+                        r.mode,
                         r.build.as_secs_f64() * 1e3,
                         "n/a",
                         "-",
@@ -423,9 +457,10 @@ pub fn json(
             let num = |x: Option<f64>| x.map_or("null".to_string(), |v| format!("{v:.6}"));
             let _ = write!(
                 out,
-                "{}{{\"name\":\"{}\",\"peer\":{},\"build_ms\":{:.3},\"us_per_query\":{},\"hits\":{},\"bytes_per_object\":{:.1},\"ratio_to_best_peer\":{},\"ratio_to_parry_rstar\":{}}}",
+                "{}{{\"name\":\"{}\",\"mode\":\"{}\",\"peer\":{},\"build_ms\":{:.3},\"us_per_query\":{},\"hits\":{},\"bytes_per_object\":{:.1},\"ratio_to_best_peer\":{},\"ratio_to_parry_rstar\":{}}}",
                 if j > 0 { "," } else { "" },
                 r.name,
+                r.mode,
                 r.peer,
                 r.build.as_secs_f64() * 1e3,
                 num(r.batch.map(|t| us_per_query(t, q))),

@@ -1,5 +1,5 @@
 //! Peer: parry3d 0.31's BVH (`parry3d::partitioning::Bvh`), built once from the
-//! spheres' AABBs with its binned SAH build. Sphere and box queries use
+//! spheres' AABBs with its binned SAH build or its PLOC build (one W4 row each). Sphere and box queries use
 //! `Bvh::intersect_aabb` with the query's bounding box (parry's SIMD node test);
 //! rays and frusta use `Bvh::leaves` with the same conservative box test Proxima's
 //! indices use (`Selection::classify_box`). Every candidate leaf then goes through
@@ -35,11 +35,13 @@ fn from_parry(b: &PAabb) -> Aabb {
 }
 
 impl ParryQuery {
-    /// Bulk build (binned SAH); leaf `i` = sphere `i`.
-    pub fn build(spheres: &[Sphere]) -> Self {
+    /// Bulk build with one of parry's strategies (`Binned`: binned SAH, its
+    /// default; `Ploc`: locally-ordered clustering, slower to build, documented
+    /// as the better tree); leaf `i` = sphere `i`.
+    pub fn build(spheres: &[Sphere], strategy: BvhBuildStrategy) -> Self {
         let aabbs: Vec<PAabb> = spheres.iter().map(|s| to_parry(&s.aabb())).collect();
         ParryQuery {
-            bvh: Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs),
+            bvh: Bvh::from_leaves(strategy, &aabbs),
             spheres: spheres.to_vec(),
         }
     }

@@ -1,5 +1,7 @@
 //! Peer: rstar 0.13's R*-tree over the spheres' AABB envelopes, bulk loaded
-//! (`RTree::bulk_load`, its OMT packing for static sets). Sphere and box queries use
+//! (`RTree::bulk_load`, its OMT packing for static sets) or filled by one
+//! `RTree::insert` per sphere (the R* insertion with forced reinsertion): one W4
+//! row each. Sphere and box queries use
 //! `locate_in_envelope_intersecting_int` with the query's bounding box; rays and
 //! frusta a custom `SelectionFunction` that unpacks a node when
 //! `Selection::classify_box` does not say `Outside` and a leaf when the exact test
@@ -44,6 +46,13 @@ impl<Q: Selection + ?Sized> SelectionFunction<Item> for Select<'_, Q> {
     }
 }
 
+fn items(spheres: &[Sphere]) -> impl Iterator<Item = Item> + '_ {
+    spheres.iter().map(|s| Item {
+        sphere: *s,
+        envelope: envelope(&s.aabb()),
+    })
+}
+
 /// The R*-tree.
 pub struct RstarQuery {
     tree: RTree<Item>,
@@ -52,16 +61,18 @@ pub struct RstarQuery {
 impl RstarQuery {
     /// Bulk load.
     pub fn build(spheres: &[Sphere]) -> Self {
-        let items = spheres
-            .iter()
-            .map(|s| Item {
-                sphere: *s,
-                envelope: envelope(&s.aabb()),
-            })
-            .collect();
         RstarQuery {
-            tree: RTree::bulk_load(items),
+            tree: RTree::bulk_load(items(spheres).collect()),
         }
+    }
+
+    /// One `insert` per sphere, in input order, into an empty tree.
+    pub fn build_by_inserts(spheres: &[Sphere]) -> Self {
+        let mut tree = RTree::new();
+        for item in items(spheres) {
+            tree.insert(item);
+        }
+        RstarQuery { tree }
     }
 
     fn by_bounds<Q: Selection>(&self, q: &Q) -> usize {

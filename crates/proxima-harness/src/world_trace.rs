@@ -14,6 +14,8 @@ use std::fmt;
 use std::path::Path;
 use std::sync::Arc;
 
+use crate::lex::{clip, expect_fields as fields, numbers, Res};
+
 /// One operation of a world trace; `slot` is the dense number of a user id
 /// ([`WorldTrace::ids`]), `mesh` an index into [`WorldTrace::meshes`].
 #[derive(Clone, Debug, PartialEq)]
@@ -162,8 +164,6 @@ impl fmt::Display for ParseError {
 
 /// Most fields on a line (`pose` and its 13).
 const MAX_FIELDS: usize = 14;
-
-type Res<T> = Result<T, String>;
 
 impl WorldTrace {
     /// Parses and checks a trace whose `mesh` files are read by `load` (given
@@ -354,47 +354,9 @@ pub fn pose(v: &[f32; 12]) -> Affine3A {
     }
 }
 
-/// Checks the field count of `cmd`.
-fn fields(cmd: &str, args: &[&str], names: &[&str]) -> Res<()> {
-    if args.len() == names.len() {
-        return Ok(());
-    }
-    let usage = if names.is_empty() {
-        format!("{cmd} takes no fields")
-    } else {
-        format!("{cmd} expects {} fields ({})", names.len(), names.join(" "))
-    };
-    Err(format!("{usage}, got {}", args.len()))
-}
-
 fn parse_id(s: &str) -> Res<u64> {
     s.parse()
         .map_err(|_| format!("bad id '{}' (expected an unsigned 64-bit integer)", clip(s)))
-}
-
-/// Parses exactly `N` finite numbers named `names`.
-fn numbers<const N: usize>(cmd: &str, args: &[&str], names: &[&str]) -> Res<[f32; N]> {
-    fields(cmd, args, names)?;
-    let mut v = [0.0; N];
-    for ((out, s), name) in v.iter_mut().zip(args).zip(names) {
-        let x: f32 = s
-            .parse()
-            .map_err(|_| format!("bad number '{}' for {name}", clip(s)))?;
-        if !x.is_finite() {
-            return Err(format!("{name} is not finite ('{}')", clip(s)));
-        }
-        *out = x;
-    }
-    Ok(v)
-}
-
-/// A token shortened for an error message.
-fn clip(s: &str) -> String {
-    const MAX: usize = 40;
-    match s.char_indices().nth(MAX) {
-        Some((i, _)) => format!("{}…", &s[..i]),
-        None => s.to_string(),
-    }
 }
 
 #[cfg(test)]

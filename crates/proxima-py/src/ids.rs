@@ -51,7 +51,7 @@ impl Ids {
 
     /// Issues the next id, for `h`.
     pub fn push(&mut self, h: Handle) -> i64 {
-        self.ordered &= self.last.map_or(true, |last| last < h);
+        self.ordered &= self.last.is_none_or(|last| last < h);
         self.last = Some(h);
         self.handles.push(Some(h));
         (self.handles.len() - 1) as i64

@@ -611,7 +611,7 @@ impl Index {
                 ids.reshape([m, k])?.into_any(),
             ],
         };
-        Ok(pyo3::types::PyTuple::new(py, items)?)
+        pyo3::types::PyTuple::new(py, items)
     }
 
     /// sweep(starts, ends, radii=0.0, *, all=False, filter=None, workers=1)
@@ -667,7 +667,7 @@ impl Index {
             PyArray1::from_vec(py, ids).into_any(),
             PyArray1::from_vec(py, t).into_any(),
         ];
-        Ok(pyo3::types::PyTuple::new(py, items)?)
+        pyo3::types::PyTuple::new(py, items)
     }
 }
 

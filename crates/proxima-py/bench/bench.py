@@ -145,11 +145,16 @@ def fcl_like(lib, rob, env, poses, coal):
 
     def model(m):
         if coal:
+            # coal's beginModel takes (triangles, vertices); its arrays go in
+            # through addVertices / addTriangles.
             b = lib.BVHModelOBBRSS()
+            b.beginModel(m.n_triangles, m.n_vertices)
+            b.addVertices(m.vertices.astype(np.float64))
+            b.addTriangles(m.faces.astype(np.int32))
         else:
             b = lib.BVHModel()
-        b.beginModel(m.n_vertices, m.n_triangles)
-        b.addSubModel(m.vertices.astype(np.float64), m.faces.astype(np.int32))
+            b.beginModel(m.n_vertices, m.n_triangles)
+            b.addSubModel(m.vertices.astype(np.float64), m.faces.astype(np.int32))
         b.endModel()
         return b
 

@@ -12,7 +12,9 @@
 - pairs: all overlapping pairs of 100,000 spheres of equal radius (W1's density)
   with `Index(...).pairs()` beside scipy's `cKDTree.query_pairs` (build + query,
   and query alone). Target: <= 0.5x cKDTree.
-- knn: `Index.nearest` arrives with issue #14; then beside `cKDTree.query`.
+- knn: k nearest (k = 1, 10) of 100,000 query points among 100,000 points
+  with `Index.nearest(metric="center")` beside `cKDTree.query` (query alone,
+  with workers, and build + query). Target: <= 0.5x cKDTree.query.
 - rays: closest hits of 100,000 rays on bunny.obj with `Mesh.cast_rays` beside
   Open3D's `RaycastingScene.cast_rays` and trimesh's ray intersector (Embree
   through embreex when installed), each where installable.
@@ -143,11 +145,16 @@ def fcl_like(lib, rob, env, poses, coal):
 
     def model(m):
         if coal:
+            # coal's beginModel takes (triangles, vertices); its arrays go in
+            # through addVertices / addTriangles.
             b = lib.BVHModelOBBRSS()
+            b.beginModel(m.n_triangles, m.n_vertices)
+            b.addVertices(m.vertices.astype(np.float64))
+            b.addTriangles(m.faces.astype(np.int32))
         else:
             b = lib.BVHModel()
-        b.beginModel(m.n_vertices, m.n_triangles)
-        b.addSubModel(m.vertices.astype(np.float64), m.faces.astype(np.int32))
+            b.beginModel(m.n_vertices, m.n_triangles)
+            b.addSubModel(m.vertices.astype(np.float64), m.faces.astype(np.int32))
         b.endModel()
         return b
 
@@ -229,7 +236,44 @@ def bench_pairs(args):
 
 
 def bench_knn(args):
-    print("\n## knn: Index.nearest arrives with issue #14 (then beside cKDTree.query)")
+    n = m = 100_000
+    print(f"\n## knn: {n:,} points, {m:,} query points (uniform in a unit cube), k = 1 and 10")
+    rng = np.random.default_rng(3)
+    c = rng.uniform(0, 1, (n, 3))
+    q = rng.uniform(0, 1, (m, 3))
+    spatial = optional("scipy.spatial")
+    kinds = ("loose-kd", "grid3d", "octree")
+    for k in (1, 10):
+        print(f"  k = {k}:")
+        base = None
+        timings = {}
+        if spatial is not None:
+            tree = spatial.cKDTree(c)
+            wd, wi = tree.query(q, k)
+            b = median_time(lambda: spatial.cKDTree(c), args.repeat)
+            t = median_time(lambda: tree.query(q, k), args.repeat)
+            tw = median_time(lambda: tree.query(q, k, workers=args.workers), args.repeat)
+            base = t
+            timings[f"scipy {version('scipy')} cKDTree.query"] = t
+            timings[f"cKDTree.query(workers={args.workers})"] = tw
+            timings["cKDTree build + query"] = b + t
+        for kind in kinds:
+            idx = proxima.Index(c, 0.0, kind=kind)
+            d, i = idx.nearest(q, k, metric="center")
+            if spatial is not None:
+                # Distances are float32 here, float64 in scipy: ids may differ
+                # only between neighbours within float32 rounding of a tie.
+                same = (i == wi).mean()
+                close = np.allclose(d, wd, rtol=1e-6, atol=1e-7)
+                print(f"  proxima {kind}: same ids as cKDTree on {same:.4%}, distances {'agree' if close else 'DISAGREE'}")
+            t = median_time(lambda: idx.nearest(q, k, metric="center"), args.repeat)
+            tw = median_time(lambda: idx.nearest(q, k, metric="center", workers=args.workers), args.repeat)
+            b = median_time(lambda: proxima.Index(c, 0.0, kind=kind), args.repeat)
+            timings[f"proxima {kind} nearest"] = t
+            timings[f"proxima {kind} nearest(workers={args.workers})"] = tw
+            timings[f"proxima {kind} build + nearest"] = b + t
+        for name, s in timings.items():
+            row(name, s, m, "query", base)
 
 
 # --- rays --------------------------------------------------------------------

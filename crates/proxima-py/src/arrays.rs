@@ -5,6 +5,7 @@
 
 use crate::errors::OrRaise;
 use numpy::{PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use proxima::broad::Filter;
 use proxima::geom::{Aabb, Frustum, Ray};
 use proxima::glam::{Affine3A, Mat3A, Mat4, Vec3, Vec3A, Vec4};
 use pyo3::exceptions::PyValueError;
@@ -307,4 +308,62 @@ pub fn aabb(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Aabb> {
     let b = Aabb::new(vec3(&v[..3]), vec3(&v[3..]));
     b.validate().or_raise_at(|| what.into())?;
     Ok(b)
+}
+
+/// One filter field (`what`: "group" or "mask") as a 32-bit set.
+fn bits(x: i64, what: &str) -> PyResult<u32> {
+    u32::try_from(x).map_err(|_| {
+        PyValueError::new_err(format!(
+            "{what} must be an integer in 0..2**32 (a bit set), got {x}"
+        ))
+    })
+}
+
+/// A `group=` / `mask=` pair as a filter: each an integer in `0..2^32`.
+pub fn filter(group: i64, mask: i64) -> PyResult<Filter> {
+    Ok(Filter::new(bits(group, "group")?, bits(mask, "mask")?))
+}
+
+/// A query's `filter=` argument: `None` (every object) or a `(group, mask)`
+/// pair of integers in `0..2^32`.
+pub fn query_filter(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Filter>> {
+    let Some(obj) = obj.filter(|o| !o.is_none()) else {
+        return Ok(None);
+    };
+    let (group, mask): (i64, i64) = obj.extract().map_err(|_| {
+        PyValueError::new_err(format!(
+            "filter must be None or a (group, mask) pair of integers, got {}",
+            obj.repr().map_or_else(|_| "?".into(), |r| r.to_string())
+        ))
+    })?;
+    filter(group, mask).map(Some)
+}
+
+/// Per-object filters for `n` objects from `group=` and `mask=` arguments,
+/// each `None` (every bit), one integer, or an `(n,)` integer array.
+pub fn filters(
+    group: Option<&Bound<'_, PyAny>>,
+    mask: Option<&Bound<'_, PyAny>>,
+    n: usize,
+) -> PyResult<Vec<Filter>> {
+    let field = |obj: Option<&Bound<'_, PyAny>>, what: &str| -> PyResult<Vec<u32>> {
+        let Some(obj) = obj.filter(|o| !o.is_none()) else {
+            return Ok(vec![u32::MAX; n]);
+        };
+        let (shape, v) = i64_values(obj, what)?;
+        let v = v
+            .into_iter()
+            .map(|x| bits(x, what))
+            .collect::<PyResult<Vec<u32>>>()?;
+        match shape[..] {
+            [] => Ok(vec![v[0]; n]),
+            [m] if m == n => Ok(v),
+            _ => Err(shape_error(what, &format!("an integer or ({n},)"), &shape)),
+        }
+    };
+    let (g, m) = (field(group, "group")?, field(mask, "mask")?);
+    Ok(g.into_iter()
+        .zip(m)
+        .map(|(g, m)| Filter::new(g, m))
+        .collect())
 }

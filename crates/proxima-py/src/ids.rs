@@ -11,6 +11,13 @@ pub struct Ids {
     handles: Vec<Option<Handle>>,
     /// What holds the objects, for messages ("index", "world").
     holder: &'static str,
+    /// The handle issued last since the holder was created or cleared.
+    last: Option<Handle>,
+    /// Whether the live handles ascend with their ids (every handle issued
+    /// since the last clear was larger than the one before). The indices break
+    /// ties by handle, so while this holds their order is the ids' order;
+    /// once a removed slot is reused it may not be.
+    ordered: bool,
 }
 
 impl Ids {
@@ -19,6 +26,8 @@ impl Ids {
         Ids {
             handles: Vec::new(),
             holder,
+            last: None,
+            ordered: true,
         }
     }
 
@@ -42,6 +51,8 @@ impl Ids {
 
     /// Issues the next id, for `h`.
     pub fn push(&mut self, h: Handle) -> i64 {
+        self.ordered &= self.last.is_none_or(|last| last < h);
+        self.last = Some(h);
         self.handles.push(Some(h));
         (self.handles.len() - 1) as i64
     }
@@ -70,6 +81,16 @@ impl Ids {
     /// Marks every id removed (new ids continue after the last one issued).
     pub fn forget_all(&mut self) {
         self.handles.iter_mut().for_each(|h| *h = None);
+        // Nothing is live: the next handles start a new order.
+        self.last = None;
+        self.ordered = true;
+    }
+
+    /// Whether handle order is id order among the live ids (see the field):
+    /// then a result the library ordered "ties by smaller handle" is ordered
+    /// "ties by smaller id". O(1).
+    pub fn ordered(&self) -> bool {
+        self.ordered
     }
 
     /// The live ids, ascending.

@@ -3,7 +3,8 @@
 //!
 //! - [`index::Index`]: any of the six broad-phase indices by name, over spheres
 //!   given as numpy arrays and named by integer ids; batch queries returning
-//!   CSR `(ids, offsets)`; `pairs()` as an `(P, 2)` array.
+//!   CSR `(ids, offsets)`; `pairs()` as an `(P, 2)` array; k nearest as
+//!   `cKDTree.query` does; sphere sweeps; per-object collision filters.
 //! - [`mesh::Mesh`]: a triangle mesh with its collision and ray BVHs, from
 //!   arrays or a file; batch ray casts with Open3D's result names.
 //! - [`collide::collide`]: mesh–mesh collision for one pose or a batch, with the
@@ -19,9 +20,8 @@
 //! interpreter released, on the calling thread or on a rayon pool of
 //! `workers` threads ([`workers`]).
 //!
-//! Still to come, each with a marked place: k nearest neighbours, sphere
-//! sweeps and collision filters on `Index` (issue #14, in `index.rs`); mesh
-//! distance queries (issue #15, in `collide.rs`).
+//! Still to come, with a marked place: mesh distance queries (issue #15, in
+//! `collide.rs`).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -5,8 +5,11 @@
 
 use crate::errors::OrRaise;
 use crate::workers::Workers;
-use proxima::broad::{AnyIndex, ParallelPairs, Query, SpatialIndex};
-use proxima::geom::{overlap, Ray};
+use proxima::broad::{
+    par_nearest, AnyIndex, Filter, Metric, Nearest, Neighbor, ParallelPairs, Query, SpatialIndex,
+};
+use proxima::geom::{overlap, Ray, Sphere, SphereSweep};
+use proxima::Handle;
 use pyo3::PyResult;
 use rayon::prelude::*;
 use std::ops::ControlFlow;
@@ -36,16 +39,22 @@ pub fn validate(queries: &[Query], what: &str) -> PyResult<()> {
     Ok(())
 }
 
-/// Every object each query selects: sorted by id, or for a ray by entry `t`
-/// along the ray, ties by id. The queries must be validated.
-pub fn select(index: &AnyIndex<u64>, queries: &[Query], workers: &Workers) -> Csr {
+/// Every object each query selects among those `filter` admits: sorted by id,
+/// or for a ray (a sweep) by entry `t` along the ray (time of impact), ties by
+/// id. The queries must be validated.
+pub fn select(
+    index: &AnyIndex<u64>,
+    queries: &[Query],
+    filter: Option<Filter>,
+    workers: &Workers,
+) -> Csr {
     if !workers.parallel() {
-        return chunk(index, queries);
+        return chunk(index, queries, filter);
     }
     let parts: Vec<Csr> = workers.run(|| {
         queries
             .par_chunks(CHUNK)
-            .map(|qs| chunk(index, qs))
+            .map(|qs| chunk(index, qs, filter))
             .collect()
     });
     let total = parts.iter().map(|p| p.ids.len()).sum();
@@ -64,8 +73,23 @@ pub fn select(index: &AnyIndex<u64>, queries: &[Query], workers: &Workers) -> Cs
     out
 }
 
+/// [`SpatialIndex::visit`] with a closure: statically dispatched when
+/// unfiltered (the common case), through the trait object otherwise.
+fn each_in(
+    index: &AnyIndex<u64>,
+    q: &Query,
+    filter: Option<Filter>,
+    mut f: impl FnMut(Handle, &Sphere, &u64) -> ControlFlow<()>,
+) {
+    // Validated by the caller: the walk cannot fail.
+    let _ = match filter {
+        None => index.for_each_in(*q, f),
+        Some(_) => index.visit(q, filter, &mut f),
+    };
+}
+
 /// [`select`] on the calling thread.
-fn chunk(index: &AnyIndex<u64>, queries: &[Query]) -> Csr {
+fn chunk(index: &AnyIndex<u64>, queries: &[Query], filter: Option<Filter>) -> Csr {
     let mut hits: Vec<(f32, u64)> = Vec::new();
     let mut out = Csr {
         ids: Vec::new(),
@@ -75,11 +99,11 @@ fn chunk(index: &AnyIndex<u64>, queries: &[Query]) -> Csr {
     out.offsets.push(0);
     for q in queries {
         hits.clear();
-        // Validated: the walk cannot fail.
-        let _ = index.for_each_in(*q, |_, s, &id| {
+        each_in(index, q, filter, |_, s, &id| {
             let t = match q {
-                // The index selected the sphere, so the ray's exact test hits.
+                // The index selected the sphere, so the exact test hits.
                 Query::Ray(r) => overlap::ray_sphere(r, s).unwrap_or(0.0),
+                Query::Sweep(w) => overlap::sweep_sphere(w, s).unwrap_or(0.0),
                 _ => 0.0,
             };
             hits.push((t, id));
@@ -93,24 +117,166 @@ fn chunk(index: &AnyIndex<u64>, queries: &[Query]) -> Csr {
     out
 }
 
-/// The first object each ray enters (smallest `t`, ties by id's handle order):
-/// `(id, t)`, or `(-1, inf)` for a miss. The rays must be validated.
-pub fn first_hits(index: &AnyIndex<u64>, rays: &[Ray], workers: &Workers) -> (Vec<i64>, Vec<f32>) {
-    let one = |r: &Ray| -> (i64, f32) {
-        match index.ray_first(r, None) {
-            Ok(Some(hit)) => match index.get(hit.handle) {
-                Ok((_, &id)) => (id as i64, hit.t),
-                Err(_) => (-1, f32::INFINITY),
-            },
+/// The first object each ray enters among those `filter` admits (smallest
+/// `t`, ties by id when `by_id`, else by handle): `(id, t)`, or `(-1, inf)` for
+/// a miss. The rays must be validated.
+pub fn first_hits(
+    index: &AnyIndex<u64>,
+    rays: &[Ray],
+    filter: Option<Filter>,
+    workers: &Workers,
+) -> (Vec<i64>, Vec<f32>) {
+    let one = |r: &Ray| hit_id(index, index.ray_first(r, filter));
+    first_each(rays, workers, one)
+}
+
+/// The first object each sweep touches among those `filter` admits: smallest
+/// time of impact, ties by smaller id. `(id, t)`, or `(-1, inf)` for a miss.
+/// The library breaks ties by handle, which is id order while `ordered`
+/// ([`Ids::ordered`](crate::ids::Ids::ordered)); otherwise the first hit is
+/// taken from every hit. The sweeps must be validated.
+pub fn first_sweeps(
+    index: &AnyIndex<u64>,
+    sweeps: &[SphereSweep],
+    filter: Option<Filter>,
+    ordered: bool,
+    workers: &Workers,
+) -> (Vec<i64>, Vec<f32>) {
+    let one = |w: &SphereSweep| {
+        if ordered {
+            return hit_id(index, index.sweep_first(w, filter));
+        }
+        let all = chunk(index, &[Query::Sweep(*w)], filter);
+        match (all.ids.first(), all.t.first()) {
+            (Some(&id), Some(&t)) => (id, t),
             _ => (-1, f32::INFINITY),
         }
     };
+    first_each(sweeps, workers, one)
+}
+
+/// A first-hit answer as `(id, t)`, `(-1, inf)` for none.
+fn hit_id(
+    index: &AnyIndex<u64>,
+    hit: proxima::Result<Option<proxima::broad::RayHit>>,
+) -> (i64, f32) {
+    match hit {
+        Ok(Some(hit)) => match index.get(hit.handle) {
+            Ok((_, &id)) => (id as i64, hit.t),
+            Err(_) => (-1, f32::INFINITY),
+        },
+        _ => (-1, f32::INFINITY),
+    }
+}
+
+/// `one` on every item, on the calling thread or the pool, unzipped.
+fn first_each<Q: Sync>(
+    items: &[Q],
+    workers: &Workers,
+    one: impl Fn(&Q) -> (i64, f32) + Sync,
+) -> (Vec<i64>, Vec<f32>) {
     let hits: Vec<(i64, f32)> = if workers.parallel() {
-        workers.run(|| rays.par_iter().with_min_len(CHUNK).map(one).collect())
+        workers.run(|| items.par_iter().with_min_len(CHUNK).map(&one).collect())
     } else {
-        rays.iter().map(one).collect()
+        items.iter().map(one).collect()
     };
     hits.into_iter().unzip()
+}
+
+/// The answers of a batch of k-nearest queries as `(M, k)` row-major arrays:
+/// distances (`inf` where fewer than `k` were found) and ids (`-1` there).
+pub struct KnnTable {
+    /// `m * k` distances, nearest first in each row.
+    pub distances: Vec<f32>,
+    /// `m * k` ids beside them.
+    pub ids: Vec<i64>,
+}
+
+/// The `k` nearest objects to each point (among those `filter` admits, at
+/// most `max_distance` away, in `metric`), nearest first, ties by smaller id.
+/// The library breaks ties by handle: id order while `ordered`; otherwise
+/// each answer's last distance `D` is re-queried for every object at most `D`
+/// away, and those are ordered by (distance, id) (about twice the cost).
+/// Points must be finite and `max_distance` not NaN or negative.
+#[allow(clippy::too_many_arguments)]
+pub fn nearest(
+    index: &AnyIndex<u64>,
+    points: &[proxima::glam::Vec3],
+    k: usize,
+    max_distance: f32,
+    metric: Metric,
+    filter: Option<Filter>,
+    ordered: bool,
+    workers: &Workers,
+) -> proxima::Result<KnnTable> {
+    let m = points.len();
+    let mut out = KnnTable {
+        distances: vec![f32::INFINITY; m * k],
+        ids: vec![-1; m * k],
+    };
+    if k == 0 || m == 0 {
+        return Ok(out);
+    }
+    let queries: Vec<Nearest> = points
+        .iter()
+        .map(|&p| Nearest::new(p, k).within(max_distance).metric(metric))
+        .collect();
+    // A row: the neighbours (handles) as ids, re-ordered when needed.
+    let fill = |q: &Nearest,
+                found: &[Neighbor],
+                scratch: &mut Vec<Neighbor>,
+                d: &mut [f32],
+                ids: &mut [i64]| {
+        let id = |h: Handle| index.get(h).map_or(-1, |(_, &id)| id as i64);
+        if !ordered {
+            let found: &[Neighbor] = if found.len() == k {
+                // Every object as near as the k-th, so that ties at the
+                // boundary go to the smaller ids.
+                let wide = Nearest {
+                    k: index.len(),
+                    max_distance: found[k - 1].distance,
+                    ..*q
+                };
+                let _ = index.nearest_into(&wide, filter, scratch);
+                &scratch[..]
+            } else {
+                found
+            };
+            let mut by_id: Vec<(f32, i64)> =
+                found.iter().map(|n| (n.distance, id(n.handle))).collect();
+            by_id.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for (j, (dist, i)) in by_id.into_iter().take(k).enumerate() {
+                d[j] = dist;
+                ids[j] = i;
+            }
+        } else {
+            for (j, n) in found.iter().enumerate() {
+                d[j] = n.distance;
+                ids[j] = id(n.handle);
+            }
+        }
+    };
+    if workers.parallel() {
+        let batch = workers.run(|| par_nearest(index, &queries, filter))?;
+        workers.run(|| {
+            (out.distances.par_chunks_mut(k))
+                .zip(out.ids.par_chunks_mut(k))
+                .enumerate()
+                .with_min_len(CHUNK)
+                .for_each_init(Vec::new, |scratch, (i, (d, ids))| {
+                    fill(&queries[i], batch.get(i), scratch, d, ids)
+                })
+        });
+    } else {
+        queries.iter().try_for_each(Nearest::validate)?;
+        let (mut buf, mut scratch) = (Vec::new(), Vec::new());
+        let rows = out.distances.chunks_mut(k).zip(out.ids.chunks_mut(k));
+        for (q, (d, ids)) in queries.iter().zip(rows) {
+            index.nearest_into(q, filter, &mut buf)?;
+            fill(q, &buf, &mut scratch, d, ids);
+        }
+    }
+    Ok(out)
 }
 
 /// Every overlapping pair once as `[smaller id, larger id]`, sorted if `sort`.

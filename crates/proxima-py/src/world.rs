@@ -97,18 +97,6 @@ impl ShapeArg<'_> {
     }
 }
 
-/// A `group=` / `mask=` pair as a filter: each an integer in `0..2^32`.
-fn filter(group: i64, mask: i64) -> PyResult<Filter> {
-    let bits = |x: i64, what: &str| {
-        u32::try_from(x).map_err(|_| {
-            PyValueError::new_err(format!(
-                "{what} must be an integer in 0..2**32 (a bit set), got {x}"
-            ))
-        })
-    };
-    Ok(Filter::new(bits(group, "group")?, bits(mask, "mask")?))
-}
-
 /// Rigid poses from an argument (see [`arrays::poses`]), each checked,
 /// naming the first bad one.
 fn checked_poses(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<Affine3A>, bool)> {
@@ -438,7 +426,7 @@ impl World {
         group: i64,
         mask: i64,
     ) -> PyResult<i64> {
-        let filter = filter(group, mask)?;
+        let filter = arrays::filter(group, mask)?;
         let pose = one_pose(pose, "pose")?;
         Ok(self.add_all(shape, &[pose], filter, true)?[0])
     }
@@ -458,7 +446,7 @@ impl World {
         group: i64,
         mask: i64,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        let filter = filter(group, mask)?;
+        let filter = arrays::filter(group, mask)?;
         let (poses, _) = checked_poses(poses, "poses")?;
         Ok(PyArray1::from_vec(
             py,
@@ -528,7 +516,7 @@ impl World {
     #[pyo3(signature = (id, *, group, mask))]
     fn set_filter(&mut self, id: i64, group: i64, mask: i64) -> PyResult<()> {
         let h = self.ids.handle(id)?;
-        let f = filter(group, mask)?;
+        let f = arrays::filter(group, mask)?;
         each_world!(&mut self.inner, w => w.set_filter(h, f)).or_raise()
     }
 
@@ -627,7 +615,7 @@ impl World {
         mask: i64,
         workers: i64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let f = filter(group, mask)?;
+        let f = arrays::filter(group, mask)?;
         let rs: Vec<Ray> = arrays::rays(rays, tmax)?;
         let workers = Workers::new(workers)?;
         let inner = &self.inner;
@@ -676,7 +664,7 @@ impl World {
         mask: i64,
         workers: i64,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let f = filter(group, mask)?;
+        let f = arrays::filter(group, mask)?;
         let (v, _) = rows(spheres, 4, "spheres")?;
         let qs: Vec<(Vec3, f32)> = v.chunks_exact(4).map(|s| (vec3(s), s[3])).collect();
         for (i, (c, r)) in qs.iter().enumerate() {
@@ -713,7 +701,7 @@ impl World {
         mask: i64,
         workers: i64,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let f = filter(group, mask)?;
+        let f = arrays::filter(group, mask)?;
         let fs: Vec<Frustum> = arrays::frusta(matrices, depth)?;
         let workers = Workers::new(workers)?;
         let inner = &self.inner;

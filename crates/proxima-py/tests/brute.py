@@ -376,3 +376,59 @@ class BruteWorld:
                 if np.isfinite(t[0]) or unsure[0]:
                     out[i] = (t[0], int(tri[0]), bool(unsure[0]))
         return out
+
+
+def knn(centers, radii, q, k, bound=np.inf, metric="surface", admit=None):
+    """The k nearest rows to the point q: `(distances, ids)` padded to k with
+    inf / -1, nearest first, ties by smaller row. Each distance is the float64
+    value on the stored float32 numbers rounded to float32, which is the
+    library's correctly rounded one except within ~1e-16 relative of a
+    rounding midpoint (never met by the seeded data). `admit`: a boolean mask
+    of the rows that may answer (a filter)."""
+    c, r, q = f32(centers), f32(radii), f32(q)
+    d = np.sqrt(((c - q) ** 2).sum(axis=1))
+    if metric == "surface":
+        d = np.maximum(d - r, 0.0)
+    d = d.astype(np.float32)
+    ok = d <= np.float32(bound)
+    if admit is not None:
+        ok &= admit
+    rows = np.nonzero(ok)[0]
+    order = rows[np.lexsort((rows, d[rows]))][:k]
+    dist = np.full(k, np.inf, dtype=np.float32)
+    ids = np.full(k, -1, dtype=np.int64)
+    dist[: len(order)] = d[order]
+    ids[: len(order)] = order
+    return dist, ids
+
+
+def sweep(centers, radii, a, b, radius, band=1e-4):
+    """A sphere of `radius` moving from a (t = 0) to b (t = 1) against every
+    row, closed form in float64: `(t, sure)` where t (N,) is each row's time
+    of first contact (inf for a miss) and `sure` (N,) marks the rows decided
+    with margin (the segment's distance to the centre is not within `band` of
+    the radii's sum); elsewhere either answer is accepted."""
+    c, r = f32(centers), f32(radii)
+    a, b, rs = f32(a), f32(b), f32(radii) + float(np.float32(radius))
+    d = b - a
+    m = a - c
+    dd = d @ d
+    mm = (m * m).sum(axis=1)
+    # The segment's closest point to each centre, for the margin.
+    s = np.clip(-(m @ d) / dd, 0.0, 1.0) if dd > 0 else np.zeros(len(c))
+    gap = np.sqrt(((m + s[:, None] * d) ** 2).sum(axis=1)) - rs
+    hit = gap <= 0
+    if dd > 0:
+        half_b = m @ d
+        disc = np.maximum(half_b * half_b - dd * (mm - rs * rs), 0.0)
+        t = (-half_b - np.sqrt(disc)) / dd
+    else:
+        t = np.zeros(len(c))
+    t = np.where(mm <= rs * rs, 0.0, t)
+    t = np.where(hit, np.clip(t, 0.0, 1.0), np.inf)
+    return t, np.abs(gap) > band * np.maximum(1.0, rs)
+
+
+def interacts(g1, m1, g2, m2):
+    """The two-way filter rule, elementwise."""
+    return ((np.asarray(g1) & np.asarray(m2)) != 0) & ((np.asarray(g2) & np.asarray(m1)) != 0)

@@ -1,12 +1,15 @@
 """Type stub of the extension module (re-exported by ``proxima``)."""
 
 import os
-from typing import Final, Literal, TypedDict
+from typing import Final, Literal, TypedDict, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 IndexKind = Literal["brute", "loose-kd", "octree", "grid2d", "hashgrid", "grid3d"]
+Metric = Literal["surface", "center"]
+QueryFilter = tuple[int, int] | None
+"""A query's ``filter=``: None (every object) or ``(group, mask)`` bit sets."""
 BoundingVolume = Literal["aabb", "kdop14", "kdop18", "kdop26", "obb", "sphere"]
 
 INDEX_KINDS: Final[list[str]]
@@ -29,6 +32,12 @@ class Index:
     (touching counts) and exact for the stored values. Batch queries return
     ``(ids, offsets)``: query ``i`` selected ``ids[offsets[i]:offsets[i+1]]``.
     ``workers``: 1 (this thread), n (a pool of n threads) or -1 (one per core).
+
+    Each object carries a collision filter, ``group`` and ``mask`` bit sets
+    in 0..2**32 (default every bit): ``pairs()`` reports two objects only if
+    each one's group meets the other's mask, and every query given
+    ``filter=(group, mask)`` reports only the objects whose filter interacts
+    with that pair the same way (Box2D's, Bullet's and Rapier's scheme).
     """
 
     def __init__(
@@ -39,6 +48,8 @@ class Index:
         kind: IndexKind = "grid3d",
         world: ArrayLike | None = None,
         r_max: float | None = None,
+        group: ArrayLike | int | None = None,
+        mask: ArrayLike | int | None = None,
     ) -> None:
         """Builds an index of ``kind`` holding the spheres ``centers`` (N, 3)
         with ``radii`` (N,) or one radius for all; row i gets id i.
@@ -48,9 +59,11 @@ class Index:
         ``r_max`` (a typical large radius) say otherwise: give both when
         building an empty index that is filled by ``insert`` later. Any sphere
         is accepted, inside the world or not; the hint only tunes speed.
+        ``group`` / ``mask``: the objects' collision filters, one integer for
+        all or (N,) integers (default every bit).
 
-        Raises ValueError on an unknown kind, a wrong shape, a non-finite value
-        or a negative radius.
+        Raises ValueError on an unknown kind, a wrong shape, a non-finite value,
+        a negative radius or filter bits outside 0..2**32.
         """
 
     @property
@@ -67,13 +80,35 @@ class Index:
     def __contains__(self, id: object) -> bool:
         """Whether ``id`` names a stored object."""
 
-    def insert(self, center: ArrayLike, radius: float) -> int:
-        """Stores one sphere and returns its id."""
+    def insert(
+        self, center: ArrayLike, radius: float, *, group: int | None = None, mask: int | None = None
+    ) -> int:
+        """Stores one sphere with collision filter ``group`` / ``mask``
+        (default every bit) and returns its id."""
 
-    def insert_many(self, centers: ArrayLike, radii: ArrayLike | float) -> NDArray[np.int64]:
-        """Stores spheres ``centers`` (K, 3) with ``radii`` (K,) or one radius;
-        returns their ids (K,), consecutive. All or nothing: a bad row raises
+    def insert_many(
+        self,
+        centers: ArrayLike,
+        radii: ArrayLike | float,
+        *,
+        group: ArrayLike | int | None = None,
+        mask: ArrayLike | int | None = None,
+    ) -> NDArray[np.int64]:
+        """Stores spheres ``centers`` (K, 3) with ``radii`` (K,) or one radius
+        and filters ``group`` / ``mask`` (each one integer or (K,)); returns
+        their ids (K,), consecutive. All or nothing: a bad row raises
         ValueError naming it and stores nothing."""
+
+    def set_filter(
+        self, ids: ArrayLike | int, *, group: ArrayLike | int, mask: ArrayLike | int
+    ) -> None:
+        """Sets the collision filter of ``ids`` (one id or (K,)); ``group`` and
+        ``mask`` each one integer or (K,). All or nothing: KeyError on an id
+        not stored, ValueError on bits outside 0..2**32."""
+
+    def filter(self, id: int) -> tuple[int, int]:
+        """An object's collision filter as ``(group, mask)``. KeyError if not
+        stored."""
 
     def remove(self, id: int) -> None:
         """Removes an object. KeyError if ``id`` is not stored."""
@@ -118,14 +153,16 @@ class Index:
         """Checks the structure's invariants (RuntimeError if one fails: a bug)."""
 
     def query_spheres(
-        self, spheres: ArrayLike, *, workers: int = 1
+        self, spheres: ArrayLike, *, filter: QueryFilter = None, workers: int = 1
     ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """Objects overlapping each sphere of ``spheres`` (M, 4): centre x, y,
         z, radius (also the point-radius query). Returns ``(ids, offsets)``,
-        each query's ids ascending. One (4,) row is a batch of one."""
+        each query's ids ascending. One (4,) row is a batch of one.
+        ``filter``: only the objects whose filter interacts with ``(group,
+        mask)`` (the same on every query)."""
 
     def query_boxes(
-        self, boxes: ArrayLike, *, workers: int = 1
+        self, boxes: ArrayLike, *, filter: QueryFilter = None, workers: int = 1
     ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """Objects overlapping each box of ``boxes`` (M, 6): min x, y, z, max
         x, y, z. Returns ``(ids, offsets)``, each query's ids ascending."""
@@ -136,6 +173,7 @@ class Index:
         tmax: ArrayLike | float | None = None,
         *,
         return_t: bool = False,
+        filter: QueryFilter = None,
         workers: int = 1,
     ) -> tuple[NDArray[np.int64], NDArray[np.int64]] | tuple[
         NDArray[np.int64], NDArray[np.int64], NDArray[np.float32]
@@ -148,7 +186,12 @@ class Index:
         (float32) beside ``ids``."""
 
     def ray_first(
-        self, rays: ArrayLike, tmax: ArrayLike | float | None = None, *, workers: int = 1
+        self,
+        rays: ArrayLike,
+        tmax: ArrayLike | float | None = None,
+        *,
+        filter: QueryFilter = None,
+        workers: int = 1,
     ) -> tuple[NDArray[np.int64], NDArray[np.float32]]:
         """The first object each ray enters (smallest entry t; between equal t,
         one of them): ``(ids (M,), t (M,))``, -1 and inf for a miss."""
@@ -158,6 +201,7 @@ class Index:
         matrices: ArrayLike,
         *,
         depth: Literal["zero_to_one", "minus_one_to_one"] = "zero_to_one",
+        filter: QueryFilter = None,
         workers: int = 1,
     ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """Objects inside each view frustum: ``matrices`` (M, 4, 4)
@@ -168,8 +212,86 @@ class Index:
         the six planes. Returns ``(ids, offsets)``, each query's ids ascending."""
 
     def pairs(self, *, sort: bool = True, workers: int = 1) -> NDArray[np.int64]:
-        """Every overlapping pair of stored objects once, (P, 2) ids with the
-        smaller first; rows sorted unless ``sort=False`` (cheaper)."""
+        """Every overlapping pair of stored objects whose filters interact,
+        once, (P, 2) ids with the smaller first; rows sorted unless
+        ``sort=False`` (cheaper)."""
+
+    @overload
+    def nearest(
+        self,
+        points: ArrayLike,
+        k: Literal[1] = 1,
+        *,
+        distance_upper_bound: float = ...,
+        metric: Metric = "surface",
+        filter: QueryFilter = None,
+        workers: int = 1,
+    ) -> tuple[NDArray[np.float32], NDArray[np.int64]]: ...
+    @overload
+    def nearest(
+        self,
+        points: ArrayLike,
+        k: int,
+        *,
+        distance_upper_bound: float = ...,
+        metric: Metric = "surface",
+        filter: QueryFilter = None,
+        workers: int = 1,
+    ) -> tuple[NDArray[np.float32], NDArray[np.int64]]:
+        """The ``k`` objects nearest to each point, like scipy's
+        ``cKDTree.query``: ``points`` (M, 3) (or one (3,) point) →
+        ``(distances, ids)``, nearest first, ties by smaller id.
+
+        Shapes follow cKDTree: (M, k) for k > 1, (M,) for k == 1, and without
+        the M axis for a single (3,) point (a float and an int for k == 1).
+        Rows with fewer than k qualifying objects are padded with distance inf
+        and id -1 (cKDTree pads with inf and n; -1 is never an id). Distances
+        are float32, ids int64.
+
+        ``metric``: "surface" (default; max(0, |c - p| - r), 0 inside a
+        sphere) or "center" (|c - p|, as cKDTree for points; equal for radius
+        0). ``distance_upper_bound``: only objects at most this far
+        (inclusive; cKDTree's is strict). ``filter``: as for
+        :meth:`query_spheres`. Each distance is correctly rounded, so every
+        kind gives the same answer bit for bit. Releases the GIL.
+
+        Raises ValueError on a wrong shape, a non-finite point, k < 1, a NaN
+        or negative bound or an unknown metric; TypeError on a non-integer k.
+        """
+
+    @overload
+    def sweep(
+        self,
+        starts: ArrayLike,
+        ends: ArrayLike,
+        radii: ArrayLike | float | None = None,
+        *,
+        all: Literal[False] = False,
+        filter: QueryFilter = None,
+        workers: int = 1,
+    ) -> tuple[NDArray[np.int64], NDArray[np.float32]]: ...
+    @overload
+    def sweep(
+        self,
+        starts: ArrayLike,
+        ends: ArrayLike,
+        radii: ArrayLike | float | None = None,
+        *,
+        all: Literal[True],
+        filter: QueryFilter = None,
+        workers: int = 1,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float32]]:
+        """Sphere casts: a sphere of radius ``radii[i]`` (scalar or (M,), >= 0;
+        default 0, the exact segment query) whose centre moves in a straight
+        line from ``starts[i]`` (t = 0) to ``ends[i]`` (t = 1), both (M, 3).
+        It touches a stored sphere when their distance comes to at most the
+        sum of the radii (closed).
+
+        Returns the first object each sweep touches, ``(ids (M,), t (M,))`` —
+        smallest time of impact, ties by smaller id, -1 and inf for a miss, t
+        = 0 when touching at the start — or with ``all=True`` every object
+        touched as ``(ids, offsets, t)``, each sweep's in order of t, ties by
+        id. ``filter`` as for :meth:`query_spheres`. Releases the GIL."""
 
 class RayCastResult(TypedDict):
     """The answer of :meth:`Mesh.cast_rays` (Open3D's names)."""

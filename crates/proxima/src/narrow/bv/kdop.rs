@@ -327,9 +327,10 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
         Kdop { d }
     }
 
-    /// Bounds the rotated k-DOP by the intersection of its rotated
-    /// [`Kdop::FRAMES`] boxes (the coordinate box, and for the 18- and 26-DOP
-    /// the three boxes of the edge-diagonal frames, each containing the k-DOP):
+    /// Bounds the rotated k-DOP by the intersection of its rotated frame boxes
+    /// (the coordinate box, and for the 18- and 26-DOP the boxes of the three
+    /// frames of orthogonal slabs `(1,±1,0)` and `z`, `(1,0,±1)` and `y`,
+    /// `(0,1,±1)` and `x`, each containing the k-DOP) [sources: kdop]:
     /// along each axis `u`, the support of a box of centre `c` and half-extents
     /// `e_j` along the unit axes `v_j`, rotated by `R`, is
     /// `u·(Rc + t) ± Σ_j |(Rᵀu)·v_j|·e_j`. O(K) per frame, conservative. The

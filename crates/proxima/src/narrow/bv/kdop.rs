@@ -564,6 +564,26 @@ mod tests {
     }
 
     #[test]
+    fn distance_bound_combines_orthogonal_slabs() {
+        // A segment along (1,-1,0) and its copy moved by (1,1,1): the boxes
+        // overlap in x and y, so the box bound is 1 (z) and the best single
+        // edge-diagonal slab gives √2; the frame of (1,1,0), (1,-1,0) and z
+        // gives the distance, √3 (the segments are parallel, the offset
+        // orthogonal to them).
+        let a = [Vec3::new(-1.0, 1.0, 0.0), Vec3::new(1.0, -1.0, 0.0)];
+        let b = a.map(|p| p + Vec3::ONE);
+        let truth = 3f32.sqrt();
+        let m = |slack| Kdop18::motion(&Affine3A::IDENTITY, slack);
+        let (ka, kb) = (Kdop18::from_points(&a), Kdop18::from_points(&b));
+        assert!((ka.distance_lower_bound_fixed(&kb) - truth).abs() < 1e-6);
+        assert!((ka.distance_lower_bound(&m(0.0), &kb) - truth).abs() < 1e-6);
+        // The slack lowers it; the 26-DOP has the same frame.
+        assert!(ka.distance_lower_bound(&m(0.01), &kb) < truth - 0.005);
+        let (ka, kb) = (Kdop26::from_points(&a), Kdop26::from_points(&b));
+        assert!((ka.distance_lower_bound_fixed(&kb) - truth).abs() < 1e-6);
+    }
+
+    #[test]
     fn transformed_bounds_the_rotated_frame_boxes() {
         let pts = [
             Vec3::new(0.3, -1.0, 2.0),

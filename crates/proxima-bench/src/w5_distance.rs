@@ -3,7 +3,8 @@
 //!
 //! `proxima-bench w5-distance [--poses FILE] [--pairs rob-env,bunny,...] [--n N]
 //! [--seed S] [--bv aabb,kdop18,...] [--margin-frac F] [--brute K]
-//! [--rotation auto|refit|conservative] [--clock cpu|wall] [--json]`
+//! [--rotation auto|refit|conservative] [--clock cpu|wall] [--peers auto|none]
+//! [--peer-reps R] [--json]`
 //!
 //! - Poses as W5 ([`crate::w5`]): `rob-env` reads the pose file (FCL's
 //!   distribution), the other pairs use `--n` generated poses.
@@ -15,6 +16,14 @@
 //!   same distance (bit for bit) on every pose; `within` agrees with it; on the
 //!   first `--brute` poses (default 3; fewer on big pairs) the distance equals
 //!   the minimum of `triangle_distance` over all triangle pairs.
+//! - The C++ peers (`--peers auto`, the default, when `scripts/peers.sh` has
+//!   built them): coal 3.0 and FCL 0.7 OBBRSS `distance` (the volume both
+//!   libraries' distance traversal is fastest with; the only one coal's
+//!   distance takes besides RSS) through the `w5_mesh` harness
+//!   ([`crate::w5::peers`]) on the same poses, `--peer-reps` times each (wall
+//!   clock); their distances are checked against ours (within `1e-5` of the
+//!   fixed mesh's diagonal; on intersecting poses, at most that), and the
+//!   table gives our medians over coal's. Use `--clock wall` for ratios.
 //!
 //! For instruction counts (stable on a shared machine) run one volume under
 //! callgrind with `--toggle-collect='*Proximity*distance*'` (the distance
@@ -23,7 +32,7 @@
 //! its share from `run`'s callers with `callgrind_annotate --tree=caller`).
 
 use crate::run::{median, Clock};
-use crate::w5::poses;
+use crate::w5::{peers, poses};
 use proxima::geom::{Aabb, Sphere};
 use proxima::glam::{Affine3A, Vec3};
 use proxima::narrow::{
@@ -34,7 +43,13 @@ use std::fmt::Write as _;
 use std::process::ExitCode;
 use std::time::Duration;
 
-const USAGE: &str = "usage: proxima-bench w5-distance [--poses FILE] [--pairs rob-env,bunny,teapot,hand-forearm,skin-ribcage] [--n N] [--seed S] [--bv aabb,kdop14,kdop18,kdop26,obb,sphere] [--margin-frac F] [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall] [--json]";
+const USAGE: &str = "usage: proxima-bench w5-distance [--poses FILE] [--pairs rob-env,bunny,teapot,hand-forearm,skin-ribcage] [--n N] [--seed S] [--bv aabb,kdop14,kdop18,kdop26,obb,sphere] [--margin-frac F] [--brute K] [--rotation auto|refit|conservative] [--clock cpu|wall] [--peers auto|none] [--peer-reps R] [--json]";
+
+/// The peers' distance configurations (library, volume).
+const PEERS: [(&str, &str); 2] = [("coal", "obbrss"), ("fcl", "obbrss")];
+/// A peer's distance may differ from ours by this fraction of the fixed mesh's
+/// diagonal (issue #15's test tolerance; GJK-based leaf tests stop early).
+const PEER_TOLERANCE: f64 = 1e-5;
 
 /// The mesh pairs of W5: name, moving mesh, fixed mesh (files in `shared/data/`).
 const PAIRS: [(&str, &str, &str); 5] = [
@@ -60,6 +75,8 @@ struct Args {
     brute: usize,
     rotation: RotationUpdate,
     clock: Clock,
+    peers: bool,
+    peer_reps: usize,
     json: bool,
 }
 
@@ -86,6 +103,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         brute: 3,
         rotation: RotationUpdate::Auto,
         clock: Clock::ThreadCpu,
+        peers: true,
+        peer_reps: 3,
         json: false,
     };
     let names: Vec<&str> = PAIRS.iter().map(|p| p.0).collect();
@@ -117,6 +136,14 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                 }
             }
             "--clock" => a.clock = Clock::parse(&value("--clock")?)?,
+            "--peers" => {
+                a.peers = match value("--peers")?.as_str() {
+                    "auto" => true,
+                    "none" => false,
+                    o => return Err(format!("--peers takes auto or none, not {o:?}")),
+                }
+            }
+            "--peer-reps" => a.peer_reps = crate::run::num::<usize>(&value("--peer-reps")?)?.max(1),
             "--json" => a.json = true,
             "-h" | "--help" => return Err(String::new()),
             o => return Err(format!("unknown argument {o:?}")),
@@ -189,6 +216,79 @@ struct PairRun {
     margin: f64,
     brute_poses: usize,
     bvs: Vec<BvRun>,
+    /// The C++ peers' distance runs, or why there are none.
+    peers: Result<Vec<PeerDistance>, String>,
+}
+
+/// One C++ peer's distance query on one mesh pair.
+struct PeerDistance {
+    /// `coal obbrss`, ...
+    name: String,
+    /// Library and version (`coal 3.0.3`).
+    version: String,
+    /// Median and mean µs per query (wall clock, over poses × reps).
+    median_us: f64,
+    mean_us: f64,
+}
+
+/// Runs the peers' distance on the pair's poses and checks their distances
+/// against `ours` (one per pose); an unbuilt harness is a note, not a failure.
+fn run_peers(
+    (name, fa, fb): (&str, &str, &str),
+    poses: &[Affine3A],
+    ours: &[f64],
+    tolerance: f64,
+    args: &Args,
+    errors: &mut Vec<String>,
+) -> Result<Vec<PeerDistance>, String> {
+    let Some(dir) = peers::harness_dir() else {
+        return Err("C++ peers not built (scripts/peers.sh builds them)".into());
+    };
+    let pose_file =
+        std::env::temp_dir().join(format!("proxima-w5d-{}-{name}.poses", std::process::id()));
+    peers::write_poses(&pose_file, poses)?;
+    let (pa, pb) = (format!("{DATA}{fa}"), format!("{DATA}{fb}"));
+    let mut out = Vec::new();
+    for config in PEERS {
+        eprintln!("  {name}: {} {} distance ...", config.0, config.1);
+        let files = (pa.as_ref(), pb.as_ref());
+        let r = peers::run_harness(&dir, config, files, &pose_file, "distance", args.peer_reps);
+        let r = match r {
+            Ok(r) if r.distances.len() == poses.len() => r,
+            Ok(r) => {
+                let e = format!("{} answers for {} poses", r.distances.len(), poses.len());
+                errors.push(format!("{name}: {} {}: {e}", config.0, config.1));
+                continue;
+            }
+            Err(e) => {
+                errors.push(format!("{name}: {e}"));
+                continue;
+            }
+        };
+        for (i, (&(theirs, ..), &d)) in r.distances.iter().zip(ours).enumerate() {
+            // Intersecting meshes: 0 here, at most the tolerance there (coal
+            // may report a penetration as a negative distance).
+            let ok = if d == 0.0 {
+                theirs <= tolerance
+            } else {
+                (theirs - d).abs() <= tolerance
+            };
+            if !ok {
+                errors.push(format!(
+                    "{name} pose {i}: {} {} distance {theirs}, ours {d}",
+                    config.0, config.1
+                ));
+            }
+        }
+        out.push(PeerDistance {
+            name: format!("{} {}", config.0, config.1),
+            version: r.lib,
+            median_us: r.median_us,
+            mean_us: r.mean_us,
+        });
+    }
+    let _ = std::fs::remove_file(&pose_file);
+    Ok(out)
 }
 
 fn load(file: &str) -> Result<TriMesh, String> {
@@ -226,7 +326,8 @@ fn run_pair(
         (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
         |(l, h), &v| (l.min(v), h.max(v)),
     );
-    let margin = args.margin_frac * (hi - lo).length() as f64;
+    let diagonal = (hi - lo).length() as f64;
+    let margin = args.margin_frac * diagonal;
     let mut bvs = Vec::new();
     for bv in &args.bvs {
         eprintln!("  {name}: {bv} ...");
@@ -272,12 +373,20 @@ fn run_pair(
             }
         }
     }
+    let peers = match bvs.first() {
+        Some(r) if args.peers => {
+            let tolerance = PEER_TOLERANCE * diagonal;
+            run_peers((name, fa, fb), &poses, &r.values, tolerance, args, errors)
+        }
+        _ => Err("not run (--peers none)".into()),
+    };
     Ok(PairRun {
         name,
         tris: (a.len(), b.len()),
         margin,
         brute_poses,
         bvs,
+        peers,
     })
 }
 
@@ -301,27 +410,62 @@ fn table(runs: &[PairRun], args: &Args) -> String {
             "\n{} ({} x {} triangles, {} poses, brute-force checked on {}; distance 0 on {} poses, within {:.4} on {})",
             p.name, p.tris.0, p.tris.1, first.values.len(), p.brute_poses, zero, p.margin, inside
         );
+        // Ratios: our medians over coal's distance median.
+        let coal = p.peers.as_ref().ok().and_then(|v| {
+            v.iter()
+                .find(|r| r.name.starts_with("coal"))
+                .map(|r| r.median_us)
+        });
+        let ratio = |t: f64| coal.map_or("-".to_string(), |c| format!("{:.2}", t / c));
         let _ = writeln!(
             s,
-            "{:<8} {:>10} {:>10} {:>9} {:>8} {:>7} {:>10} {:>10} {:>9} {:>8}",
-            "bv", "dist mean", "dist med", "Nv", "Np", "Nu", "within mn", "within md", "Nv", "Np"
+            "{:<12} {:>10} {:>10} {:>9} {:>8} {:>7} {:>10} {:>10} {:>9} {:>8} {:>7} {:>7}",
+            "bv",
+            "dist mean",
+            "dist med",
+            "Nv",
+            "Np",
+            "Nu",
+            "within mn",
+            "within md",
+            "Nv",
+            "Np",
+            "d/coal",
+            "w/coal"
         );
         for r in &p.bvs {
             let c = r.counters;
+            let (dm, wm) = (us(median(&r.distance)), us(median(&r.within)));
             let _ = writeln!(
                 s,
-                "{:<8} {:>10.1} {:>10.1} {:>9.0} {:>8.0} {:>7.0} {:>10.1} {:>10.1} {:>9.0} {:>8.0}",
+                "{:<12} {:>10.1} {:>10.1} {:>9.0} {:>8.0} {:>7.0} {:>10.1} {:>10.1} {:>9.0} {:>8.0} {:>7} {:>7}",
                 r.name,
                 us(mean(&r.distance)),
-                us(median(&r.distance)),
+                dm,
                 c[0],
                 c[1],
                 c[2],
                 us(mean(&r.within)),
-                us(median(&r.within)),
+                wm,
                 c[3],
-                c[4]
+                c[4],
+                ratio(dm),
+                ratio(wm)
             );
+        }
+        match &p.peers {
+            Ok(v) => {
+                for r in v {
+                    let _ = writeln!(
+                        s,
+                        "{:<12} {:>10.1} {:>10.1}   ({}, distance, wall clock)",
+                        r.name, r.mean_us, r.median_us, r.version
+                    );
+                }
+            }
+            Err(e) => {
+                let _ = writeln!(s, "peers: {e}");
+            }
         }
     }
     s
@@ -346,6 +490,10 @@ fn json(runs: &[PairRun], args: &Args) -> String {
         for (j, r) in p.bvs.iter().enumerate() {
             let c = r.counters;
             let _ = write!(s, "{}{{\"bv\":\"{}\",\"distance_mean_us\":{:.2},\"distance_median_us\":{:.2},\"within_mean_us\":{:.2},\"within_median_us\":{:.2},\"nv\":{:.1},\"np\":{:.1},\"nu\":{:.1},\"within_nv\":{:.1},\"within_np\":{:.1}}}", if j > 0 { "," } else { "" }, r.name, us(mean(&r.distance)), us(median(&r.distance)), us(mean(&r.within)), us(median(&r.within)), c[0], c[1], c[2], c[3], c[4]);
+        }
+        s.push_str("],\"peers\":[");
+        for (j, r) in p.peers.iter().flatten().enumerate() {
+            let _ = write!(s, "{}{{\"peer\":\"{}\",\"version\":\"{}\",\"distance_mean_us\":{:.2},\"distance_median_us\":{:.2}}}", if j > 0 { "," } else { "" }, r.name, r.version, r.mean_us, r.median_us);
         }
         s.push_str("]}");
     }

@@ -59,6 +59,8 @@ const TOLERANCE: [(&str, f32); 1] = [("coal", 1e-6)];
 pub struct HarnessRun {
     /// `pairs N` or `hit 0|1` per pose, as numbers.
     pub answers: Vec<u64>,
+    /// `distance D I J` per pose (`--mode distance`): `D` and the triangles.
+    pub distances: Vec<(f64, u64, u64)>,
     /// Build time of each tree (`# build_us A B`), µs.
     pub build_us: (f64, f64),
     /// Median and mean time per query, µs (wall clock, over poses × reps).
@@ -104,6 +106,9 @@ fn parse_output(text: &str, mode: &str) -> Result<HarnessRun, String> {
         match w.as_slice() {
             ["pairs", n] if mode == "all" => r.answers.push(num(n)? as u64),
             ["hit", h] if mode == "first" => r.answers.push(num(h)? as u64),
+            ["distance", d, i, j] if mode == "distance" => {
+                r.distances.push((num(d)?, num(i)? as u64, num(j)? as u64))
+            }
             ["#", "lib", rest @ ..] => r.lib = rest.join(" "),
             ["#", "build_us", a, b] => r.build_us = (num(a)?, num(b)?),
             ["#", "query_us", "median", m, "mean", x, ..] => {

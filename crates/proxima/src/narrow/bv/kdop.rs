@@ -219,24 +219,36 @@ impl<const K: usize> Kdop<K> {
         })
     }
 
-    /// `1 / |axis_i|` for the slabs after the coordinate ones: corner diagonals
-    /// have length √3, edge diagonals √2.
-    #[inline(always)]
-    fn inv_norm(i: usize) -> f32 {
-        if Self::axis_index(i) < 7 {
-            0.577_350_26
-        } else {
-            std::f32::consts::FRAC_1_SQRT_2
-        }
-    }
+    /// Triples of slabs with mutually orthogonal axes ("frames"): within a
+    /// frame the slab gaps are the coordinates of a box gap in a rotated basis,
+    /// so their Euclidean norm bounds the distance. The 18- and 26-DOP have four
+    /// (the coordinate axes; each edge-diagonal pair `(1,±1,0)`, `(1,0,±1)`,
+    /// `(0,1,±1)` with the remaining coordinate axis), the 14-DOP only the first.
+    const FRAMES: &'static [[usize; 3]] = match K {
+        18 => &[[0, 1, 2], [3, 6, 2], [4, 7, 1], [5, 8, 0]],
+        26 => &[[0, 1, 2], [7, 10, 2], [8, 11, 1], [9, 12, 0]],
+        _ => &[[0, 1, 2]],
+    };
+
+    /// The slabs in no frame (the corner diagonals of the 14- and 26-DOP), each
+    /// bounding the distance alone.
+    const SINGLES: std::ops::Range<usize> = match K {
+        18 => 3..3,
+        _ => 3..7,
+    };
 
     /// The distance lower bound of `self` shifted by `m` (a [`BoundingVolume::motion`],
-    /// or no shift) and `o`: the Euclidean gap of the three coordinate slabs (the
-    /// boxes' distance), or the largest gap of another slab divided by its axis'
-    /// length, whichever is larger. Each is a lower bound on the distance of the
-    /// contents. Written as plain loops over the slabs (no NaN-aware `max`, no
-    /// zero shift added) because it runs once per volume pair; a result that
-    /// overflowed or is NaN is computed again in `f64` ([`wide_gap`]).
+    /// or no shift) and `o`: the largest over the [`Kdop::FRAMES`] of the
+    /// Euclidean norm of their three slab gaps (each divided by its axis'
+    /// length; the first frame is the boxes' distance), and over the other
+    /// slabs of their gap divided by their axis' length. Each is a lower bound
+    /// on the distance of the contents (the distance of two sets is at least
+    /// that of their boxes in any orthonormal basis); on W5's bunny × bunny
+    /// the diagonal frames raise the bound of the pairs the descent visits
+    /// (see `BENCHMARKS.md`, W5 distance). Written as plain loops over the
+    /// slabs (no NaN-aware `max`, no zero shift added) because it runs once per
+    /// volume pair; a result that overflowed or is NaN is computed again in
+    /// `f64` ([`wide_gap`], with the coordinate frame and single slabs only).
     #[inline(always)]
     fn gap(&self, m: Option<&[f32; K]>, o: &Self) -> f32 {
         let h = Self::H;
@@ -248,25 +260,27 @@ impl<const K: usize> Kdop<K> {
             };
             (lo, hi, o.d[i], o.d[i + h])
         };
-        let g = |i: usize| {
+        // Squared scaled gaps (`0` where the slabs overlap; NaN stays NaN).
+        let mut q = [0.0f32; K];
+        let mut total = 0.0f32;
+        for (i, qi) in q.iter_mut().enumerate().take(h) {
             let (lo, hi, lo_o, hi_o) = slab(i);
-            fmax(lo_o - hi, lo - hi_o)
-        };
-        let mut sq = 0.0f32;
-        for i in 0..3 {
-            let x = fmax(g(i), 0.0);
-            sq += x * x;
+            let g = fmax(fmax(lo_o - hi, lo - hi_o), 0.0) * Self::inv_len(i);
+            *qi = g * g;
+            total += *qi;
         }
-        let mut slabs = 0.0f32;
-        for i in 3..h {
-            slabs = fmax(slabs, g(i) * Self::inv_norm(i));
+        let mut r2 = 0.0f32;
+        for f in Self::FRAMES {
+            r2 = fmax(r2, q[f[0]] + q[f[1]] + q[f[2]]);
         }
-        let r = fmax(sq.sqrt(), slabs);
-        if r <= f32::MAX {
-            r
+        for i in Self::SINGLES {
+            r2 = fmax(r2, q[i]);
+        }
+        if total <= f32::MAX {
+            r2.sqrt()
         } else {
             // Overflowed (gaps beyond √f32::MAX) or NaN (infinite interval ends).
-            wide_gap(slab, h, |i| if i < 3 { 1.0 } else { Self::inv_norm(i) })
+            wide_gap(slab, h, Self::inv_len)
         }
     }
 }
@@ -313,9 +327,15 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
         Kdop { d }
     }
 
-    /// Bounds the rotated AABB part of the k-DOP (its first 3 slabs): along each
-    /// axis `u`, the support of a box of centre `c` and half-extents `e` rotated by
-    /// `R` is `u·(Rc + t) ± |Rᵀu|·e`. O(K), conservative.
+    /// Bounds the rotated k-DOP by the intersection of its rotated frame boxes
+    /// (the coordinate box, and for the 18- and 26-DOP the boxes of the three
+    /// frames of orthogonal slabs `(1,±1,0)` and `z`, `(1,0,±1)` and `y`,
+    /// `(0,1,±1)` and `x`, each containing the k-DOP) [sources: kdop]:
+    /// along each axis `u`, the support of a box of centre `c` and half-extents
+    /// `e_j` along the unit axes `v_j`, rotated by `R`, is
+    /// `u·(Rc + t) ± Σ_j |(Rᵀu)·v_j|·e_j`. O(K) per frame, conservative. The
+    /// diagonal frames cut the corners of the rotated coordinate box (W5
+    /// bunny × bunny distance, k-DOP18: see `BENCHMARKS.md`, W5 distance).
     ///
     /// `Rᵀu` for the integer axes is a sum of rows of `R` (`rotated_axis`): no
     /// matrix product per slab (this runs once per visited node of a rotated
@@ -323,18 +343,43 @@ impl<const K: usize> BoundingVolume for Kdop<K> {
     #[inline]
     fn transformed(&self, pose: &Affine3A) -> Self {
         let h = Self::H;
-        let lo = Vec3A::new(self.d[0], self.d[1], self.d[2]);
-        let hi = Vec3A::new(self.d[h], self.d[h + 1], self.d[h + 2]);
-        let c = (lo + hi) * 0.5;
-        let e = (hi - lo) * 0.5;
-        let pc = project13(Vec3::from(pose.transform_point3a(c)));
         let rows = pose.matrix3.transpose();
-        let mut d = [0.0; K];
-        for i in 0..h {
-            let k = Self::axis_index(i);
-            let r = rotated_axis(&rows, k).abs().dot(e);
-            d[i] = pc[k] - r;
-            d[i + h] = pc[k] + r;
+        let ru: [Vec3A; K] = std::array::from_fn(|i| {
+            if i < h {
+                rotated_axis(&rows, Self::axis_index(i))
+            } else {
+                Vec3A::ZERO
+            }
+        });
+        // The intersection of the frames' bounds: lows from -∞, highs from +∞.
+        let mut d = [f32::INFINITY; K];
+        for v in d.iter_mut().take(h) {
+            *v = f32::NEG_INFINITY;
+        }
+        for f in Self::FRAMES {
+            // Frame slab `j` is `lo_j <= a_j·p <= hi_j` with the integer axis
+            // `a_j = |a_j| v_j`: centre `Σ_j (lo_j + hi_j)/2 · a_j / |a_j|²`,
+            // half-extent `(hi_j - lo_j)/2 / |a_j|` along `v_j`; below, `w_j` is
+            // `1/|a_j|²` and `(Rᵀu)·v_j · e_j = (Rᵀu)·a_j · (hi_j - lo_j)/2 · w_j`.
+            let mut c = Vec3A::ZERO;
+            let mut a = [Vec3A::ZERO; 3];
+            let mut e = [0.0f32; 3];
+            for j in 0..3 {
+                let s = f[j];
+                let w = Self::inv_len(s) * Self::inv_len(s);
+                a[j] = Vec3A::from(Self::slab_axis(s));
+                c += a[j] * ((self.d[s] + self.d[s + h]) * 0.5 * w);
+                e[j] = (self.d[s + h] - self.d[s]) * 0.5 * w;
+            }
+            let pc = project13(Vec3::from(pose.transform_point3a(c)));
+            for i in 0..h {
+                let r = ru[i].dot(a[0]).abs() * e[0]
+                    + ru[i].dot(a[1]).abs() * e[1]
+                    + ru[i].dot(a[2]).abs() * e[2];
+                let k = pc[Self::axis_index(i)];
+                d[i] = fmax(d[i], k - r);
+                d[i + h] = fmin(d[i + h], k + r);
+            }
         }
         Kdop { d }
     }
@@ -519,7 +564,27 @@ mod tests {
     }
 
     #[test]
-    fn transformed_bounds_the_rotated_box_part() {
+    fn distance_bound_combines_orthogonal_slabs() {
+        // A segment along (1,-1,0) and its copy moved by (1,1,1): the boxes
+        // overlap in x and y, so the box bound is 1 (z) and the best single
+        // edge-diagonal slab gives √2; the frame of (1,1,0), (1,-1,0) and z
+        // gives the distance, √3 (the segments are parallel, the offset
+        // orthogonal to them).
+        let a = [Vec3::new(-1.0, 1.0, 0.0), Vec3::new(1.0, -1.0, 0.0)];
+        let b = a.map(|p| p + Vec3::ONE);
+        let truth = 3f32.sqrt();
+        let m = |slack| Kdop18::motion(&Affine3A::IDENTITY, slack);
+        let (ka, kb) = (Kdop18::from_points(&a), Kdop18::from_points(&b));
+        assert!((ka.distance_lower_bound_fixed(&kb) - truth).abs() < 1e-6);
+        assert!((ka.distance_lower_bound(&m(0.0), &kb) - truth).abs() < 1e-6);
+        // The slack lowers it; the 26-DOP has the same frame.
+        assert!(ka.distance_lower_bound(&m(0.01), &kb) < truth - 0.005);
+        let (ka, kb) = (Kdop26::from_points(&a), Kdop26::from_points(&b));
+        assert!((ka.distance_lower_bound_fixed(&kb) - truth).abs() < 1e-6);
+    }
+
+    #[test]
+    fn transformed_bounds_the_rotated_frame_boxes() {
         let pts = [
             Vec3::new(0.3, -1.0, 2.0),
             Vec3::new(1.5, 0.2, -0.7),
@@ -528,33 +593,49 @@ mod tests {
         ];
         let q = glam::Quat::from_axis_angle(Vec3::new(0.3, -0.8, 0.5).normalize(), 1.1);
         let pose = Affine3A::from_rotation_translation(q, Vec3::new(4.0, -2.0, 0.5));
-        fn check<const K: usize>(pts: &[Vec3], pose: &Affine3A) {
+        // Returns how much the diagonal frames tightened the coordinate box's
+        // bound (summed over the slabs).
+        fn check<const K: usize>(pts: &[Vec3], pose: &Affine3A) -> f32 {
+            let h = K / 2;
             let k = Kdop::<K>::from_points(pts);
             let t = k.transformed(pose);
-            // Every rotated point (and every rotated corner of the AABB part) inside.
-            let (lo, hi) = (
-                Vec3::new(k.d[0], k.d[1], k.d[2]),
-                Vec3::new(k.d[K / 2], k.d[K / 2 + 1], k.d[K / 2 + 2]),
-            );
-            let corners = (0..8).map(|c| {
-                Vec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), hi, lo)
-            });
-            for p in pts.iter().copied().chain(corners) {
-                assert!(t.inflated(1e-5).contains_point(pose.transform_point3(p)));
+            // Every rotated point inside.
+            for p in pts {
+                assert!(t.inflated(1e-5).contains_point(pose.transform_point3(*p)));
             }
-            // And each slab is the support of the rotated box: `u·(Rc + t) ± |Rᵀu|·e`
-            // with `Rᵀu` as a matrix product.
-            let (c, e) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
-            for i in 0..K / 2 {
-                let u = Kdop::<K>::axis(i).unwrap();
-                let m = u.dot(pose.transform_point3(c));
-                let r = (Mat3::from(pose.matrix3).transpose() * u).abs().dot(e);
-                assert!((t.d[i] - (m - r)).abs() < 1e-5, "{K} {i}");
-                assert!((t.d[i + K / 2] - (m + r)).abs() < 1e-5, "{K} {i}");
+            // Each slab is the intersection over the frames of the support of the
+            // rotated frame box, `u·(Rc + t) ± Σ_j |(Rᵀu)·v_j| e_j` with `Rᵀu` as
+            // a matrix product and the unit axes `v_j`.
+            let rt = Mat3::from(pose.matrix3).transpose();
+            let (mut lo, mut hi) = ([f32::MIN; 13], [f32::MAX; 13]);
+            let mut gain = 0.0;
+            for (n, f) in Kdop::<K>::FRAMES.iter().enumerate() {
+                let v = f.map(|s| Kdop::<K>::axis(s).unwrap().normalize());
+                let len = f.map(|s| Kdop::<K>::axis(s).unwrap().length());
+                let mid = |j: usize| (k.d[f[j]] + k.d[f[j] + h]) * 0.5 / len[j];
+                let c = v[0] * mid(0) + v[1] * mid(1) + v[2] * mid(2);
+                let e = |j: usize| (k.d[f[j] + h] - k.d[f[j]]) * 0.5 / len[j];
+                for i in 0..h {
+                    let u = Kdop::<K>::axis(i).unwrap();
+                    let m = u.dot(pose.transform_point3(c));
+                    let ru = rt * u;
+                    let r = (0..3).map(|j| ru.dot(v[j]).abs() * e(j)).sum::<f32>();
+                    if n > 0 {
+                        gain += (lo[i].max(m - r) - lo[i]) + (hi[i] - hi[i].min(m + r));
+                    }
+                    lo[i] = lo[i].max(m - r);
+                    hi[i] = hi[i].min(m + r);
+                }
             }
+            for i in 0..h {
+                assert!((t.d[i] - lo[i]).abs() < 1e-5, "{K} {i}");
+                assert!((t.d[i + h] - hi[i]).abs() < 1e-5, "{K} {i}");
+            }
+            gain
         }
-        check::<14>(&pts, &pose);
-        check::<18>(&pts, &pose);
-        check::<26>(&pts, &pose);
+        assert_eq!(check::<14>(&pts, &pose), 0.0);
+        // The diagonal frames cut the rotated coordinate box here.
+        assert!(check::<18>(&pts, &pose) > 0.1);
+        assert!(check::<26>(&pts, &pose) > 0.1);
     }
 }

@@ -79,7 +79,8 @@ pub trait BoundingVolume: Copy + Debug + Send + Sync + 'static {
 
     /// A volume containing this one moved by `pose` (a rigid motion). Exact for
     /// [`Obb`] and spheres; for axis-aligned volumes a conservative bound (the
-    /// k-DOP of the rotated AABB part), the source's refit being the exact alternative
+    /// k-DOP of the rotated box, for the 18- and 26-DOP intersected with those of
+    /// the rotated boxes of their diagonal frames), the source's refit being the exact alternative
     /// [sources: bvh-rotate].
     fn transformed(&self, pose: &Affine3A) -> Self;
 
@@ -139,10 +140,12 @@ pub trait BoundingVolume: Copy + Debug + Send + Sync + 'static {
     /// cut of the distance queries ([`Proximity`](crate::narrow::Proximity)).
     /// The motion's slack is subtracted, so the bound holds for the points the
     /// volumes were fitted to despite rounding. Never negative, never NaN for
-    /// finite input. Cost: about that of [`BoundingVolume::overlaps`] (k-DOPs and
-    /// AABBs: the Euclidean gap of the coordinate slabs, then the largest gap of
-    /// the other slabs over their normalized axes; OBBs: the largest gap over the
-    /// separating axes; spheres: exact).
+    /// finite input. Cost: about that of [`BoundingVolume::overlaps`] (AABBs: the
+    /// Euclidean gap of the coordinate slabs; k-DOPs: the largest Euclidean gap
+    /// over the frames of mutually orthogonal slabs, the coordinate one and for
+    /// the 18- and 26-DOP three of edge diagonals, and of the remaining slabs
+    /// over their normalized axes; OBBs: the largest gap over the separating
+    /// axes; spheres: exact).
     fn distance_lower_bound(&self, motion: &Self::Motion, other: &Self) -> f32;
 
     /// [`BoundingVolume::distance_lower_bound`] of two volumes in the same frame,

@@ -12,7 +12,7 @@
 //! Before timing, the answers to the first `C` queries of every structure are
 //! checked against LooseKdTree's (which the library's oracle tests check
 //! against brute force): same length, the same distances within `1e-6`
-//! relative (ties may order ids differently), and every id returned at the
+//! of `|c - q| + r` (ties may order ids differently), and every id returned at the
 //! distance reported for it. A structure that disagrees is reported (exit 1)
 //! and not timed. Then each batch runs `R` rounds round-robin; the table gives
 //! build time, median µs per query, and the ratio to the best peer and to the
@@ -184,15 +184,17 @@ pub fn query_points(side: f32, q: usize, seed: u64) -> Vec<Vec3> {
 }
 
 /// Why `got` is not a correct answer where `want` (the reference) is, or
-/// `None` when it is: same length, the same distance at every rank (within
-/// `1e-6` relative), distinct ids, each at the distance it is reported with.
+/// `None` when it is: same length, distinct ids, and at every rank the
+/// reported distance equals the reference's and the true distance of the id
+/// returned, within `1e-6` of the magnitudes involved (`|c - q| + r`: `f32`
+/// peers compute `|c - q| - r` with that cancellation). Ties may order ids
+/// differently.
 pub fn disagreement(
     set: &[Sphere],
     q: Vec3,
     want: &[(u32, f32)],
     got: &[(u32, f32)],
 ) -> Option<String> {
-    let close = |a: f32, b: f32| (a - b).abs() <= 1e-6 * a.abs().max(b.abs()).max(1.0);
     if want.len() != got.len() {
         return Some(format!("{} results, reference {}", got.len(), want.len()));
     }
@@ -205,8 +207,9 @@ pub fn disagreement(
         let Some(s) = set.get(g.0 as usize) else {
             return Some(format!("rank {rank}: unknown id {}", g.0));
         };
+        let tol = 1e-6 * (s.center.distance(q) + s.radius).max(1.0);
         let true_d = overlap::point_sphere_distance(q, s);
-        if !close(w.1, g.1) || !close(true_d, g.1) {
+        if (w.1 - g.1).abs() > tol || (true_d - g.1).abs() > tol {
             return Some(format!(
                 "rank {rank}: id {} at {} (its distance {true_d}), reference id {} at {}",
                 g.0, g.1, w.0, w.1

@@ -20,6 +20,14 @@ $B w4 --json > $D/w4.json 2>/dev/null
 $B w4 --threads 2 --clock wall --only UniformGrid3d,LinearOctree,LooseKdTree,rstar,parry3d > $D/w4-wall-t2.txt 2>/dev/null
 $B w4 --threads 1 --clock wall --only UniformGrid3d,LinearOctree,LooseKdTree,rstar,parry3d > $D/w4-wall-t1.txt 2>/dev/null
 uptime >> $D/load.txt
+# W7 (k nearest: points and spheres, k = 1, 10, 100) on 100k and 1M, and W8
+# (100k sphere sweeps); both check every peer's answers before timing.
+$B w7 --n 100000 > $D/w7-100k.txt 2>/dev/null
+$B w7 --n 100000 --json > $D/w7-100k.json 2>/dev/null
+$B w7 --n 1000000 --reps 3 > $D/w7-1m.txt 2>/dev/null
+$B w8 > $D/w8.txt 2>/dev/null
+$B w8 --json > $D/w8.json 2>/dev/null
+uptime >> $D/load.txt
 # W5 with the C++ peers (FCL, coal) when scripts/peers.sh has built them (the
 # table says so otherwise); wall clock, as their harness measures.
 $B w5 --clock wall > $D/w5.txt 2>/dev/null

@@ -15,6 +15,9 @@
 //! - [`w5_distance`]: W5's poses through the distance queries (issue #15);
 //! - [`w6`]: rays vs one mesh (its own runner, table and agreement check), with
 //!   its peers (obvhs, bvh, parry3d's `TriMesh`) beside it, as W4's are;
+//! - [`w7`]: k nearest neighbours on W4's set (points and spheres) beside
+//!   kiddo, rstar and parry3d; [`w8`]: sphere sweeps through it beside
+//!   parry3d's shape cast; [`query_args`]: their shared options and timing;
 //! - [`world`]: the collision world's scenes (tumble, arms, deep
 //!   interpenetration, churn) as world traces, on Proxima's world and on FCL's
 //!   through the `fcl_world` harness in the same run;
@@ -28,6 +31,7 @@
 pub mod chart;
 pub mod parry;
 pub mod parry_mesh;
+pub mod query_args;
 pub mod registry;
 pub mod report;
 pub mod run;
@@ -36,4 +40,6 @@ pub mod w4;
 pub mod w5;
 pub mod w5_distance;
 pub mod w6;
+pub mod w7;
+pub mod w8;
 pub mod world;

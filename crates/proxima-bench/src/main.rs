@@ -1,5 +1,6 @@
 //! `proxima-bench w1|w2|w3|w9 [--n N] [--frames F] [--seed S] [--only A,B] [--clock cpu|wall] [--threads K] [--json]`
 //! `proxima-bench w5 …` (see `proxima_bench::w5`), `w5-distance …` (`proxima_bench::w5_distance`)
+//! `proxima-bench w7 …` (k nearest, `proxima_bench::w7`), `w8 …` (sphere sweeps, `proxima_bench::w8`)
 //! `proxima-bench world …` (see `proxima_bench::world`)
 //! `proxima-bench chart FILE.json... --out FILE.svg [--metric NAME]`
 //!
@@ -19,7 +20,7 @@ use proxima_harness::workloads::Kind;
 use std::process::ExitCode;
 
 const USAGE: &str =
-    "usage: proxima-bench w1|w2|w3|w9 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--threads K] [--json]\n       proxima-bench w4 [--help]\n       proxima-bench w5 [--help]\n       proxima-bench w5-distance [--help]\n       proxima-bench w6 [--help]\n       proxima-bench world [--help]\n       proxima-bench chart FILE.json... --out FILE.svg [--metric NAME] [--title T]";
+    "usage: proxima-bench w1|w2|w3|w9 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--threads K] [--json]\n       proxima-bench w4 [--help]\n       proxima-bench w5 [--help]\n       proxima-bench w5-distance [--help]\n       proxima-bench w6 [--help]\n       proxima-bench w7 [--help]\n       proxima-bench w8 [--help]\n       proxima-bench world [--help]\n       proxima-bench chart FILE.json... --out FILE.svg [--metric NAME] [--title T]";
 
 struct Args {
     kind: Kind,
@@ -94,6 +95,8 @@ fn main() -> ExitCode {
         Some("w5") => return proxima_bench::w5::main(argv.into_iter().skip(1)),
         Some("w5-distance") => return proxima_bench::w5_distance::main(argv.into_iter().skip(1)),
         Some("w6") => return proxima_bench::w6::main(argv.into_iter().skip(1)),
+        Some("w7") => return proxima_bench::w7::main(argv.into_iter().skip(1)),
+        Some("w8") => return proxima_bench::w8::main(argv.into_iter().skip(1)),
         Some("world") => return proxima_bench::world::main(argv.into_iter().skip(1)),
         _ => {}
     }

@@ -151,7 +151,12 @@ fn order(s: &[proxima::geom::Sphere], morton: bool) -> Vec<u32> {
 
 /// Proxima's index of `kind` as W4 builds it: configured by the library for
 /// the scene's hint, bulk-loaded in the given order.
-fn proxima(kind: IndexKind, s: &[proxima::geom::Sphere], scene: &Scene, morton: bool) -> Proxima {
+pub(crate) fn proxima(
+    kind: IndexKind,
+    s: &[proxima::geom::Sphere],
+    scene: &Scene,
+    morton: bool,
+) -> Proxima {
     let index = kind
         .build(&scene.hint())
         .unwrap_or_else(|e| panic!("{kind}: {e}"));

@@ -53,8 +53,8 @@ const FLAT_CELLS: u64 = 64;
 const LEAF_CELLS: u64 = 16;
 
 impl<T, S: Store> CellGrid<T, S> {
-    /// Reports every object `q` selects, each once: a ray walks its cells
-    /// (`ray.rs`), other shapes visit the key box of their bounds (every key
+    /// Reports every object `q` selects, each once: a ray or a sweep walks
+    /// its cells (`ray.rs`), other shapes visit the key box of their bounds (every key
     /// for a frustum), then the oversized list is tested.
     pub fn walk<Q: Selection + ?Sized>(
         &self,
@@ -62,7 +62,9 @@ impl<T, S: Store> CellGrid<T, S> {
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         if let Some(ray) = q.as_ray() {
-            self.visit_ray(ray, &mut f)?;
+            self.visit_cast(ray, &mut f)?;
+        } else if let Some(sweep) = q.as_sweep() {
+            self.visit_cast(sweep, &mut f)?;
         } else {
             let lattice = self.store.lattice();
             let kb = match q.bounds() {

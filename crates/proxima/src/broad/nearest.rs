@@ -1,7 +1,8 @@
 //! k nearest neighbours [sources: index-queries]: the query ([`Nearest`]), its
 //! answer ([`Neighbor`]), the distances ([`Metric`]), and the reference search
 //! every index starts from (an expanding sphere query), which the indices with
-//! a better search override.
+//! a better search override: the trees' best-first searches, and the grids'
+//! growing box of cells ([`grow_box`]).
 
 use super::cell_grid::keys::KeyBox;
 use super::walk::Walk;

@@ -342,14 +342,19 @@ macro_rules! cell_grid_index {
             ) -> Option<$crate::broad::RayHit> {
                 self.grid.first_hit(ray, filter)
             }
-            /// The cell walk along the sweep's segment, widened by its radius.
+            /// The cell walk along the sweep's segment, widened by its radius;
+            /// a scan of the cells of its box when they are few.
             #[inline]
             fn first_sweep_hit(
                 &self,
                 sweep: &$crate::geom::SphereSweep,
                 filter: Option<$crate::broad::Filter>,
             ) -> Option<$crate::broad::RayHit> {
-                self.grid.first_hit(sweep, filter)
+                if self.grid.sweep_is_short(sweep) {
+                    $crate::broad::walk::scan_first(self, sweep, filter)
+                } else {
+                    self.grid.first_hit(sweep, filter)
+                }
             }
             /// The growing box of cells (`cell_grid/nearest.rs`).
             #[inline]

@@ -1,8 +1,10 @@
 //! k nearest neighbours [sources: index-queries]: the query ([`Nearest`]), its
 //! answer ([`Neighbor`]), the distances ([`Metric`]), and the reference search
 //! every index starts from (an expanding sphere query), which the indices with
-//! a better search override.
+//! a better search override: the trees' best-first searches, and the grids'
+//! growing box of cells ([`grow_box`]).
 
+use super::cell_grid::keys::KeyBox;
 use super::walk::Walk;
 use super::Filter;
 use crate::error::check_vec3;
@@ -308,5 +310,90 @@ fn next_up(x: f32) -> f32 {
         f32::from_bits(1)
     } else {
         f32::from_bits(x.to_bits() + 1)
+    }
+}
+
+/// The grids' k-nearest search [sources: index-queries]: a box of cells
+/// growing one face at a time around the query's cell, nearest face first.
+///
+/// `start` is the query point's cell, already clamped into `cells`, the box
+/// of cells that may hold anything (so a query far outside the grid starts
+/// at the grid's edge, not at its own far-away cell). `visit(best, slab,
+/// seen)` offers every object referenced from the cells of `slab` that was
+/// not referenced from any cell of `seen` (empty at first; `seen ∪ slab` is
+/// again a box), and may break to say that it offered everything (a store
+/// that gave up growing and scanned). `face(a, upper, k)` is a lower bound on
+/// the distance of every object whose cells all lie beyond the face of axis
+/// `a` starting at key `k` (above it if `upper`, else below), correctly
+/// rounded down; `f32::INFINITY` when nothing can lie there.
+///
+/// The box grows across the face with the smallest bound, one layer of cells
+/// at a time, and the search stops when that bound exceeds the heap's
+/// [`KBest::bound`] (strictly: an object at exactly the bound may still enter
+/// with a smaller handle) or every face reached the edge of `cells`. An object
+/// never seen has all its cells beyond one face, so its distance is at least
+/// that face's bound: the answer is brute force's. Growing the nearest face
+/// rather than whole rings (Chebyshev shells) costs the same in an even scene
+/// and far less for a query outside it, whose k nearest lie in the grid's
+/// near layer: rings would sweep the whole grid to prove it. Each face's
+/// bound changes only when it moves, so a step costs one bound and one slab.
+pub(crate) fn grow_box(
+    best: &mut KBest<'_>,
+    start: KeyBox,
+    cells: KeyBox,
+    axes: usize,
+    face: impl Fn(usize, bool, i32) -> f32,
+    mut visit: impl FnMut(&mut KBest<'_>, &KeyBox, &KeyBox) -> ControlFlow<()>,
+) {
+    if cells.is_empty() {
+        return;
+    }
+    let mut seen = start;
+    if visit(best, &start, &KeyBox::EMPTY).is_break() {
+        return;
+    }
+    let bound_of = |seen: &KeyBox, a: usize, upper: bool| {
+        if upper && seen.hi[a] < cells.hi[a] {
+            face(a, true, seen.hi[a] + 1)
+        } else if !upper && seen.lo[a] > cells.lo[a] {
+            face(a, false, seen.lo[a] - 1)
+        } else {
+            f32::INFINITY
+        }
+    };
+    let mut bounds = [[f32::INFINITY; 2]; 3];
+    for (a, b) in bounds.iter_mut().enumerate().take(axes) {
+        *b = [bound_of(&seen, a, false), bound_of(&seen, a, true)];
+    }
+    loop {
+        let mut next = (f32::INFINITY, 0, 0);
+        for (a, b) in bounds.iter().enumerate().take(axes) {
+            for (side, &d) in b.iter().enumerate() {
+                if d < next.0 {
+                    next = (d, a, side);
+                }
+            }
+        }
+        let (d, a, side) = next;
+        if d == f32::INFINITY || d > best.bound() {
+            return;
+        }
+        let mut slab = seen;
+        if side == 1 {
+            slab.hi[a] += 1;
+            slab.lo[a] = slab.hi[a];
+        } else {
+            slab.lo[a] -= 1;
+            slab.hi[a] = slab.lo[a];
+        }
+        if visit(best, &slab, &seen).is_break() {
+            return;
+        }
+        if side == 1 {
+            seen.hi[a] = slab.hi[a];
+        } else {
+            seen.lo[a] = slab.lo[a];
+        }
+        bounds[a][side] = bound_of(&seen, a, side == 1);
     }
 }

@@ -71,6 +71,12 @@ pub trait Selection: sealed::Sealed {
     fn as_ray(&self) -> Option<&Ray> {
         None
     }
+
+    /// The query as a [`SphereSweep`], if it is one: grids walk the cells
+    /// along its segment, widened by its radius, instead of its bounding box.
+    fn as_sweep(&self) -> Option<&SphereSweep> {
+        None
+    }
 }
 
 impl Selection for Sphere {
@@ -212,9 +218,8 @@ impl Selection for Ray {
 
 /// A sweep selects what it touches ([`overlap::sweep_sphere`], exact); boxes
 /// are tested with [`overlap::sweep_aabb`], conservative and monotone, so a
-/// box holding a touched sphere is never `Outside`. No `Inside` answers: the
-/// segment walks of the grids (`as_ray`) do not apply to a sweep's thickness,
-/// so the grids use its bounding box.
+/// box holding a touched sphere is never `Outside`. No `Inside` answers. The
+/// grids walk the cells along its segment widened by its radius (`as_sweep`).
 impl Selection for SphereSweep {
     fn validate(&self) -> Result<()> {
         SphereSweep::validate(self)
@@ -234,6 +239,9 @@ impl Selection for SphereSweep {
     /// The swept volume's box, rounded outward.
     fn bounds(&self) -> Option<Aabb> {
         Some(self.aabb())
+    }
+    fn as_sweep(&self) -> Option<&SphereSweep> {
+        Some(self)
     }
 }
 

@@ -103,6 +103,12 @@ pub(crate) trait Cast: Selection {
     /// [`overlap::sweep_aabb`]); monotone in the box, so front-to-back searches
     /// may skip a box entered after the best contact so far.
     fn enter(&self, b: &Aabb) -> Option<f32>;
+    /// The line the cast's centre follows, as a ray whose parameter is the
+    /// cast's, and how far from that line the cast reaches: `0` for a ray; a
+    /// sweep's radius plus the rounding of its direction `to - from` (which
+    /// the ray rounds but the exact tests do not). The grids' segment walks
+    /// follow it, widened by the reach, conservatively.
+    fn path(&self) -> (Ray, f32);
 }
 
 impl Cast for Ray {
@@ -114,6 +120,10 @@ impl Cast for Ray {
     fn enter(&self, b: &Aabb) -> Option<f32> {
         overlap::ray_aabb(self, b).map(|(t0, _)| t0)
     }
+    #[inline]
+    fn path(&self) -> (Ray, f32) {
+        (*self, 0.0)
+    }
 }
 
 impl Cast for SphereSweep {
@@ -124,6 +134,15 @@ impl Cast for SphereSweep {
     #[inline]
     fn enter(&self, b: &Aabb) -> Option<f32> {
         overlap::sweep_aabb(self, b).map(|(t0, _)| t0)
+    }
+    /// From `from` along `to - from` up to `t = 1`, reaching the radius plus
+    /// 2^-22 of the end points' magnitude (more than the rounding of
+    /// `to - from`, and of `from + (to - from) t`, at any `t` in `[0, 1]`).
+    #[inline]
+    fn path(&self) -> (Ray, f32) {
+        let ray = Ray::with_max_t(self.from, self.to - self.from, 1.0);
+        let m = self.from.abs().max(self.to.abs()).max_element();
+        (ray, self.radius + m * (1.0 / 4194304.0))
     }
 }
 

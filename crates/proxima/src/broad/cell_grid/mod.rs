@@ -16,6 +16,7 @@ mod hashed;
 pub(crate) mod keys;
 mod link;
 mod list;
+mod nearest;
 mod pairs;
 mod query;
 mod ray;
@@ -340,6 +341,30 @@ macro_rules! cell_grid_index {
                 filter: Option<$crate::broad::Filter>,
             ) -> Option<$crate::broad::RayHit> {
                 self.grid.first_hit(ray, filter)
+            }
+            /// The cell walk along the sweep's segment, widened by its radius;
+            /// a scan of the cells of its box when they are few.
+            #[inline]
+            fn first_sweep_hit(
+                &self,
+                sweep: &$crate::geom::SphereSweep,
+                filter: Option<$crate::broad::Filter>,
+            ) -> Option<$crate::broad::RayHit> {
+                if self.grid.sweep_is_short(sweep) {
+                    $crate::broad::walk::scan_first(self, sweep, filter)
+                } else {
+                    self.grid.first_hit(sweep, filter)
+                }
+            }
+            /// The growing box of cells (`cell_grid/nearest.rs`).
+            #[inline]
+            fn knn_into(
+                &self,
+                query: &$crate::broad::Nearest,
+                filter: Option<$crate::broad::Filter>,
+                out: &mut Vec<$crate::broad::Neighbor>,
+            ) {
+                self.grid.nearest(query, filter, out)
             }
         }
     };

@@ -39,7 +39,7 @@ use super::list::{CellEntry, Packed};
 use super::store::{Store, Within};
 use super::CellGrid;
 use crate::broad::Selection;
-use crate::geom::{Aabb, Frustum, Relation, Sphere};
+use crate::geom::{Aabb, Frustum, Relation, Sphere, SphereSweep};
 use crate::Handle;
 use glam::Vec3;
 use std::ops::ControlFlow;
@@ -53,8 +53,8 @@ const FLAT_CELLS: u64 = 64;
 const LEAF_CELLS: u64 = 16;
 
 impl<T, S: Store> CellGrid<T, S> {
-    /// Reports every object `q` selects, each once: a ray walks its cells
-    /// (`ray.rs`), other shapes visit the key box of their bounds (every key
+    /// Reports every object `q` selects, each once: a ray or a sweep walks
+    /// its cells (`ray.rs`), other shapes visit the key box of their bounds (every key
     /// for a frustum), then the oversized list is tested.
     pub fn walk<Q: Selection + ?Sized>(
         &self,
@@ -62,7 +62,9 @@ impl<T, S: Store> CellGrid<T, S> {
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         if let Some(ray) = q.as_ray() {
-            self.visit_ray(ray, &mut f)?;
+            self.visit_cast(ray, &mut f)?;
+        } else if let Some(sweep) = q.as_sweep().filter(|s| !self.sweep_is_short(s)) {
+            self.visit_cast(sweep, &mut f)?;
         } else {
             let lattice = self.store.lattice();
             let kb = match q.bounds() {
@@ -79,6 +81,17 @@ impl<T, S: Store> CellGrid<T, S> {
             }
         }
         ControlFlow::Continue(())
+    }
+
+    /// True if the cells of `sweep`'s bounding box are few enough
+    /// ([`FLAT_CELLS`]) that visiting them all costs less than walking the
+    /// segment, which tests each cell's box against the sweep (W8-shaped
+    /// sweeps 2.5 cells long on the hash grid: 12.3 k instructions by the box,
+    /// 17.0 k by the walk).
+    #[inline]
+    pub fn sweep_is_short(&self, sweep: &SphereSweep) -> bool {
+        let lattice = self.store.lattice();
+        lattice.aabb_box(&sweep.aabb(), S::AXES).volume() <= FLAT_CELLS
     }
 
     /// True if an object with lowest key `lo` is reported from `key` by a query

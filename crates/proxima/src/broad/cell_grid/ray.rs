@@ -1,5 +1,16 @@
-//! Rays and segments: walk the cells along the ray inside the occupied box, or
-//! scan the occupied cells when the walk would be longer.
+//! Rays, segments and sphere sweeps: walk the cells along the ray (a sweep's
+//! segment, widened by its radius) inside the occupied box, or scan the
+//! occupied cells when the walk would be longer.
+//!
+//! **Sweeps** [sources: index-queries]: a sphere of radius `r` moving along a
+//! segment touches an object iff its contact point lies within `r` of the
+//! segment, so the walk follows the segment ([`Cast::path`]) with every
+//! strip's parameter interval and cell ranges widened by `r` (plus the
+//! rounding of the segment's direction): the cell holding the contact point
+//! is in the strip whose interval holds the time of contact. Cells are tested
+//! with [`sweep_aabb`](crate::geom::overlap::sweep_aabb) and objects with the
+//! exact [`sweep_sphere`](crate::geom::overlap::sweep_sphere), through [`Cast`], so a ray and a sweep share
+//! this one walk.
 //!
 //! The walk is a conservative DDA in strips along the dominant gridded axis `a`
 //! of the direction: strip `i` holds the ray for the parameters `[ta, tb]`
@@ -28,8 +39,9 @@ use super::keys::{Key, KeyBox, REL_PAD};
 use super::list::{CellEntry, Packed};
 use super::store::Store;
 use super::CellGrid;
+use crate::broad::walk::Cast;
 use crate::broad::{Filter, RayHit};
-use crate::geom::{overlap, Aabb, Ray, Sphere};
+use crate::geom::{Aabb, Ray, Sphere};
 use crate::Handle;
 use std::ops::ControlFlow;
 
@@ -59,12 +71,12 @@ fn meet((a0, a1): (i32, i32), b0: i32, b1: i32) -> bool {
 type Ranges = [(i32, i32); 2];
 
 impl<T, S: Store> CellGrid<T, S> {
-    /// Walks the cells along `ray`, feeding `step` the candidates whose cells'
-    /// report boxes the ray touches (each object at most once) and the strip
-    /// ends.
-    fn walk_ray(
+    /// Walks the cells along `cast`'s path (widened by its reach, see
+    /// [`Cast::path`]), feeding `step` the candidates whose cells' report
+    /// boxes the cast touches (each object at most once) and the strip ends.
+    fn walk_ray<C: Cast>(
         &self,
-        ray: &Ray,
+        cast: &C,
         mut step: impl FnMut(Step<'_, S::Packed>) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let occ = self.store.occupied();
@@ -73,16 +85,24 @@ impl<T, S: Store> CellGrid<T, S> {
         }
         let lat = self.store.lattice();
         let lim = lat.limits;
+        let (ray, r) = cast.path();
         let (o, d) = (ray.origin, ray.dir);
         // The slab test's rounding grows with the origin's magnitude: pad the
         // boxes by as much so the box test never rejects a sphere the exact test
         // hits.
         let extra = o.abs().max_element() * RAY_PAD;
-        // Does the ray touch the spheres reported from `key` by a visit whose
+        // How far beyond the path's padded coordinates a sweep reaches (with
+        // the rounding of adding it); 0 for a ray.
+        let slack = if r > 0.0 {
+            r + (o.abs().max_element() + r) * RAY_PAD
+        } else {
+            0.0
+        };
+        // Does the cast touch the spheres reported from `key` by a visit whose
         // ranges start at `from`?
         let touches = |key: Key, from: Key| {
             let b = self.report_box(&KeyBox::single(key), &KeyBox::single(from), 2.0);
-            overlap::ray_aabb(ray, &b.grown(extra)).is_some()
+            cast.enter(&b.grown(extra)).is_some()
         };
         let ad = d.abs();
         let (a, b, c) = if S::AXES == 2 {
@@ -99,9 +119,10 @@ impl<T, S: Store> CellGrid<T, S> {
             (2, 0, 1)
         };
         if d[a] == 0.0 {
-            // Vertical over the 2D grid (or a zero direction): the cells of the
-            // origin's point.
-            let kb = lat.aabb_box(&Aabb::new(o, o), S::AXES).intersect(&occ);
+            // Vertical over the 2D grid, a zero direction or a sweep of no
+            // length: the cells within reach of the origin's point.
+            let near = Aabb::new(o - slack, o + slack);
+            let kb = lat.aabb_box(&near, S::AXES).intersect(&occ);
             return self.store.cells_in(&kb, |key, es| {
                 if !touches(key, kb.lo) {
                     return ControlFlow::Continue(());
@@ -116,42 +137,61 @@ impl<T, S: Store> CellGrid<T, S> {
         }
 
         let forward = d[a] > 0.0;
-        let line_t = |line: i32| (lat.origin[a] + line as f32 * lat.cell - o[a]) / d[a];
-        let io = lat.coord(o[a], a);
-        let (start, t_start) = if forward {
-            if io > occ.hi[a] {
-                return ControlFlow::Continue(());
-            }
-            if io < occ.lo[a] {
-                (occ.lo[a], line_t(occ.lo[a]).max(0.0))
-            } else {
-                (io, 0.0)
-            }
-        } else {
-            if io < occ.lo[a] {
-                return ControlFlow::Continue(());
-            }
-            if io > occ.hi[a] {
-                (occ.hi[a], line_t(occ.hi[a] + 1).max(0.0))
-            } else {
-                (io, 0.0)
-            }
+        // The parameter at which the path's coordinate on `a` is `off` past
+        // the cell line `line`.
+        let line_t =
+            |line: i32, off: f32| (lat.origin[a] + line as f32 * lat.cell + off - o[a]) / d[a];
+        // Strip `i`'s parameter interval: where the path is within reach of
+        // the cells `i` along `a` (the border strips reach to infinity).
+        let enter_t = |i: i32| match forward {
+            true if i > lim.lo[a] => line_t(i, -slack),
+            false if i < lim.hi[a] => line_t(i + 1, slack),
+            _ => f32::NEG_INFINITY,
         };
-        if t_start > ray.max_t {
+        let exit_t = |i: i32| match forward {
+            true if i < lim.hi[a] => line_t(i + 1, slack),
+            false if i > lim.lo[a] => line_t(i, -slack),
+            _ => f32::INFINITY,
+        };
+        // The path's coordinate on `axis` at t, padded and widened by the
+        // reach; f32::min/max skip the NaN of ∞ − ∞ at an infinite end.
+        let at = |axis: usize, t: f32| {
+            let v = if d[axis] == 0.0 {
+                o[axis]
+            } else {
+                o[axis] + d[axis] * t
+            };
+            let pad = (o[axis].abs() + (d[axis] * t).abs()) * RAY_PAD + slack;
+            (v - pad, v + pad)
+        };
+        let (o0, o1) = if r > 0.0 { at(a, 0.0) } else { (o[a], o[a]) };
+        let start = if forward {
+            let s = lat.coord(o0, a);
+            if s > occ.hi[a] {
+                return ControlFlow::Continue(());
+            }
+            s.max(occ.lo[a])
+        } else {
+            let s = lat.coord(o1, a);
+            if s < occ.lo[a] {
+                return ControlFlow::Continue(());
+            }
+            s.min(occ.hi[a])
+        };
+        if enter_t(start) > ray.max_t {
             return ControlFlow::Continue(());
         }
-        // The last strip: the cell of the ray's end, padded in the direction of
-        // travel (far from the origin `o + d t` rounds by up to its magnitude
-        // times epsilon, and so do the strips' `t`s, which can then all round to
-        // `max_t`: the walk must stop at this cell, not wait for a `t` beyond
-        // `max_t`).
+        // The last strip: the cell of the path's end, padded in the direction
+        // of travel (far from the origin `o + d t` rounds by up to its
+        // magnitude times epsilon, and so do the strips' `t`s, which can then
+        // all round to `max_t`: the walk must stop at this cell, not wait for a
+        // `t` beyond `max_t`).
         let end = if ray.max_t.is_finite() {
-            let v = ray.at(ray.max_t)[a];
-            let pad = (o[a].abs() + (d[a] * ray.max_t).abs()) * RAY_PAD;
+            let (v0, v1) = at(a, ray.max_t);
             if forward {
-                lat.coord(v + pad, a)
+                lat.coord(v1, a)
             } else {
-                lat.coord(v - pad, a)
+                lat.coord(v0, a)
             }
         } else if forward {
             lim.hi[a]
@@ -159,29 +199,17 @@ impl<T, S: Store> CellGrid<T, S> {
             lim.lo[a]
         };
         let end = end.clamp(occ.lo[a], occ.hi[a]);
-        // The ray's coordinate on `axis` at t, padded; f32::min/max skip the NaN
-        // of ∞ − ∞ at an infinite end.
-        let at = |axis: usize, t: f32| {
-            let v = if d[axis] == 0.0 {
-                o[axis]
+        // One strip: whether a strip follows, its parameter interval
+        // `[ta, tb]` and its raw ranges on b and c (a flat c stays at its one
+        // cell).
+        let strip = |i: i32, prev: Option<(i32, Ranges)>| {
+            let more = if forward {
+                i < lim.hi[a]
             } else {
-                o[axis] + d[axis] * t
+                i > lim.lo[a]
             };
-            let pad = (o[axis].abs() + (d[axis] * t).abs()) * RAY_PAD;
-            (v - pad, v + pad)
-        };
-        // One strip: its end line, its parameter interval's end `tb` and its raw
-        // ranges on b and c (a flat c stays at its one cell).
-        let strip = |i: i32, ta: f32, prev: Option<(i32, Ranges)>| {
-            let end_line = if forward {
-                (i < lim.hi[a]).then_some(i + 1)
-            } else {
-                (i > lim.lo[a]).then_some(i)
-            };
-            let tb = end_line
-                .map_or(f32::INFINITY, line_t)
-                .min(ray.max_t)
-                .max(ta);
+            let ta = enter_t(i).max(0.0).min(ray.max_t);
+            let tb = exit_t(i).min(ray.max_t).max(ta);
             let mut ranges = [(lim.lo[b], lim.hi[b]), (lim.lo[c], lim.hi[c])];
             for (j, axis) in [b, c].into_iter().enumerate() {
                 if axis >= S::AXES {
@@ -201,9 +229,12 @@ impl<T, S: Store> CellGrid<T, S> {
                 }
                 ranges[j] = (r0, r1);
             }
-            (end_line, tb, ranges)
+            (more, ta, tb, ranges)
         };
-        if S::SPARSE && !self.walk_is_cheap(ray, (a, b, c), (start, t_start, end), &strip) {
+        let next = |i: i32| if forward { i + 1 } else { i - 1 };
+        // The walk is over once the next strip starts beyond the path's end.
+        let last = |i: i32, more: bool| !more || i == end || enter_t(next(i)) > ray.max_t;
+        if S::SPARSE && !self.walk_is_cheap(&ray, (a, b, c), (start, end), slack, &strip, &last) {
             // Scan: each object from its own lowest cell.
             return self.store.cells(|key, es| {
                 if !touches(key, lim.lo) {
@@ -218,10 +249,10 @@ impl<T, S: Store> CellGrid<T, S> {
             });
         }
 
-        let (mut i, mut ta) = (start, t_start);
+        let mut i = start;
         let mut prev: Option<(i32, Ranges)> = None;
         loop {
-            let (end_line, tb, ranges) = strip(i, ta, prev);
+            let (more, ta, _, ranges) = strip(i, prev);
             let [(b0, b1), (c0, c1)] = ranges;
             let mut from = [0; 3];
             (from[a], from[b], from[c]) = (i, b0, c0);
@@ -250,34 +281,34 @@ impl<T, S: Store> CellGrid<T, S> {
                 ControlFlow::Continue(())
             })?;
             prev = Some((i, ranges));
-            // Everything whose hit point lies before this strip's start was met
+            // Everything whose contact lies before this strip's start was met
             // in earlier strips (a whole strip of margin absorbs rounding).
             step(Step::StripDone { t_done: ta })?;
-            let Some(next_line) = end_line else { break };
-            if (tb >= ray.max_t && line_t(next_line) > ray.max_t) || i == end {
+            if last(i, more) {
                 break;
             }
-            i = if forward { i + 1 } else { i - 1 };
+            i = next(i);
             if i < occ.lo[a] || i > occ.hi[a] {
                 break;
             }
-            ta = tb;
         }
         ControlFlow::Continue(())
     }
 
-    /// Whether walking the strips `start ..= end` (along `a`, from `t_start`)
-    /// costs no more than a few lookups per occupied cell; else the caller
-    /// scans. Far from the origin the padding can make every strip as wide as
-    /// the occupied box (a fuzzed ray took 89 s walking): when the padding may
-    /// exceed a cell somewhere along the walk, a dry run of it (arithmetic
-    /// only) adds up the strips' clipped areas.
+    /// Whether walking the strips `start ..= end` (along `a`) costs no more
+    /// than a few lookups per occupied cell; else the caller scans. Far from
+    /// the origin the padding can make every strip as wide as the occupied
+    /// box (a fuzzed ray took 89 s walking), and so can a sweep's reach: when
+    /// the padding and reach may exceed half a cell somewhere along the walk,
+    /// a dry run of it (arithmetic only) adds up the strips' clipped areas.
     fn walk_is_cheap(
         &self,
         ray: &Ray,
         (a, b, c): (usize, usize, usize),
-        (start, t_start, end): (i32, f32, i32),
-        strip: &impl Fn(i32, f32, Option<(i32, Ranges)>) -> (Option<i32>, f32, Ranges),
+        (start, end): (i32, i32),
+        slack: f32,
+        strip: &impl Fn(i32, Option<(i32, Ranges)>) -> (bool, f32, f32, Ranges),
+        last: &impl Fn(i32, bool) -> bool,
     ) -> bool {
         let cells = self.store.cell_count() as u64;
         let walk = (end as i64 - start as i64).unsigned_abs() + 1;
@@ -285,23 +316,10 @@ impl<T, S: Store> CellGrid<T, S> {
             return false;
         }
         let lat = self.store.lattice();
-        let (o, d) = (ray.origin, ray.dir);
-        let forward = d[a] > 0.0;
         // The largest parameter of the walk, and the padding there.
-        let border = if forward {
-            end >= lat.limits.hi[a]
-        } else {
-            end <= lat.limits.lo[a]
-        };
-        let far = if forward { end + 1 } else { end };
-        let t_end = if border {
-            ray.max_t
-        } else {
-            ray.max_t
-                .min((lat.origin[a] + far as f32 * lat.cell - o[a]) / d[a])
-        };
-        let mag = (o.abs() + d.abs() * t_end).max_element();
-        if 2.0 * (mag * (RAY_PAD + 1.1 * REL_PAD) + lat.pad) < lat.cell {
+        let (_, _, t_end, _) = strip(end, None);
+        let mag = (ray.origin.abs() + ray.dir.abs() * t_end).max_element();
+        if 2.0 * (mag * (RAY_PAD + 1.1 * REL_PAD) + lat.pad + slack) < lat.cell {
             // At most 4 cells per axis in each strip.
             return true;
         }
@@ -313,42 +331,38 @@ impl<T, S: Store> CellGrid<T, S> {
             ((rb1 as i64 - rb0 as i64 + 1).max(0) * (rc1 as i64 - rc0 as i64 + 1).max(0)) as u64
         };
         let budget = LOOKUPS_PER_STRIP.saturating_mul(cells) + 64;
-        let (mut i, mut ta) = (start, t_start);
+        let forward = ray.dir[a] > 0.0;
+        let mut i = start;
         let mut cost = 0u64;
         let mut prev = None;
         loop {
-            let (end_line, tb, ranges) = strip(i, ta, prev);
+            let (more, _, _, ranges) = strip(i, prev);
             cost = cost.saturating_add(area(ranges).min(cells));
             if cost > budget {
                 return false;
             }
             prev = Some((i, ranges));
-            let Some(next_line) = end_line else {
-                return true;
-            };
-            let next_t = (lat.origin[a] + next_line as f32 * lat.cell - o[a]) / d[a];
-            if (tb >= ray.max_t && next_t > ray.max_t) || i == end {
+            if last(i, more) {
                 return true;
             }
             i = if forward { i + 1 } else { i - 1 };
             if i < occ.lo[a] || i > occ.hi[a] {
                 return true;
             }
-            ta = tb;
         }
     }
 
-    /// Every gridded object the ray touches, each once (the caller adds the
-    /// oversized ones).
-    pub(super) fn visit_ray(
+    /// Every gridded object the ray or sweep touches, each once (the caller
+    /// adds the oversized ones).
+    pub(super) fn visit_cast<C: Cast>(
         &self,
-        ray: &Ray,
+        cast: &C,
         f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        self.walk_ray(ray, |s| match s {
+        self.walk_ray(cast, |s| match s {
             Step::Candidate(e) => {
                 let s = &self.spheres[e.slot as usize];
-                if overlap::ray_sphere(ray, s).is_some() {
+                if cast.contact(s).is_some() {
                     let (h, v) = self.resolve(e.slot);
                     f(h, s, v)
                 } else {
@@ -359,22 +373,22 @@ impl<T, S: Store> CellGrid<T, S> {
         })
     }
 
-    /// The first hit (smallest `t`, ties by handle) among the objects `filter`
-    /// admits: the oversized objects first, then the walk, stopping once a hit
-    /// precedes the strip just finished.
-    pub fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
+    /// The first contact of a ray or sweep (smallest `t`, ties by handle)
+    /// among the objects `filter` admits: the oversized objects first, then
+    /// the walk, stopping once a contact precedes the strip just finished.
+    pub fn first_hit<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
         let admits = |slot: u32| filter.map_or(true, |f| f.interacts(self.filters[slot as usize]));
         for &slot in &self.oversized {
-            if let Some(t) = overlap::ray_sphere(ray, &self.spheres[slot as usize]) {
+            if let Some(t) = cast.contact(&self.spheres[slot as usize]) {
                 if admits(slot) {
                     RayHit::offer(&mut best, t, self.handle(slot));
                 }
             }
         }
-        let _ = self.walk_ray(ray, |s| match s {
+        let _ = self.walk_ray(cast, |s| match s {
             Step::Candidate(e) => {
-                if let Some(t) = overlap::ray_sphere(ray, &self.spheres[e.slot as usize]) {
+                if let Some(t) = cast.contact(&self.spheres[e.slot as usize]) {
                     if admits(e.slot) {
                         RayHit::offer(&mut best, t, self.handle(e.slot));
                     }

@@ -205,3 +205,20 @@ fn grid2d_descent_matches_brute_force() {
     );
     check_all(&g, &o, &mut rng, &b);
 }
+
+/// k nearest and sweeps on both stores against brute force (see
+/// [`knn_sweep_suite`](crate::broad::test_util::knn_sweep_suite)).
+#[test]
+fn nearest_and_sweeps_match_brute_force() {
+    use crate::broad::test_util::knn_sweep_suite;
+    let w = Aabb::new(Vec3::ZERO, vec3(60.0, 60.0, 6.0));
+    for seed in 1..3 {
+        knn_sweep_suite(HashGrid::new(1.0).unwrap(), w, seed);
+        let flat = UniformGrid2d::with_config(Grid2dConfig {
+            world: w,
+            cell_size: 2.0,
+        });
+        knn_sweep_suite(flat.unwrap(), w, seed);
+        knn_sweep_suite(UniformGrid2d::new(w, 0.0).unwrap(), w, seed);
+    }
+}

@@ -7,6 +7,7 @@
 //! (the same across rayon's threads), `validate`.
 
 mod cells;
+mod nearest;
 mod pairs;
 #[cfg(feature = "parallel")]
 mod par_pairs;
@@ -343,16 +344,16 @@ impl<T> Walk<T> for UniformGrid3d<T> {
         query: &Q,
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        match (query.as_ray(), query.bounds()) {
-            (Some(ray), _) => self.visit_ray(ray, &mut f)?,
-            (None, Some(b)) => {
-                let (lo, hi) = self.geom.range(&b);
-                self.visit_range(query, lo, hi, &mut f)?;
-            }
-            (None, None) => {
-                let hi = self.geom.dims.map(|d| d - 1);
-                self.visit_range(query, [0; 3], hi, &mut f)?;
-            }
+        if let Some(ray) = query.as_ray() {
+            self.visit_cast(ray, &mut f)?;
+        } else if let Some(sweep) = query.as_sweep() {
+            self.visit_cast(sweep, &mut f)?;
+        } else if let Some(b) = query.bounds() {
+            let (lo, hi) = self.geom.range(&b);
+            self.visit_range(query, lo, hi, &mut f)?;
+        } else {
+            let hi = self.geom.dims.map(|d| d - 1);
+            self.visit_range(query, [0; 3], hi, &mut f)?;
         }
         for &slot in &self.large {
             let s = &self.spheres[slot as usize];
@@ -370,6 +371,34 @@ impl<T> Walk<T> for UniformGrid3d<T> {
 
     fn object_count(&self) -> usize {
         self.items.len()
+    }
+
+    /// Front to back along the path's dominant axis (`grid3d/query.rs`).
+    fn first_hit(
+        &self,
+        ray: &crate::geom::Ray,
+        filter: Option<Filter>,
+    ) -> Option<crate::broad::RayHit> {
+        self.first_cast(ray, filter)
+    }
+
+    /// Front to back along the segment's dominant axis (`grid3d/query.rs`).
+    fn first_sweep_hit(
+        &self,
+        sweep: &crate::geom::SphereSweep,
+        filter: Option<Filter>,
+    ) -> Option<crate::broad::RayHit> {
+        self.first_cast(sweep, filter)
+    }
+
+    /// The growing box of cells (`grid3d/nearest.rs`).
+    fn knn_into(
+        &self,
+        query: &crate::broad::Nearest,
+        filter: Option<Filter>,
+        out: &mut Vec<crate::broad::Neighbor>,
+    ) {
+        self.nearest_impl(query, filter, out)
     }
 
     fn walk_pairs(

@@ -1,8 +1,10 @@
 //! Range, frustum and ray queries: visit a set of cells that must hold the centre
 //! of every selected gridded object, each cell once (so each object once).
 
+use super::cells::Geometry;
 use super::UniformGrid3d;
-use crate::broad::Selection;
+use crate::broad::walk::Cast;
+use crate::broad::{Filter, RayHit, Selection};
 use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
 use crate::Handle;
 use std::ops::ControlFlow;
@@ -177,59 +179,63 @@ impl<T> UniformGrid3d<T> {
         ControlFlow::Continue(())
     }
 
-    /// Reports the gridded objects hit by `ray`.
-    ///
-    /// The ray is clipped to the bounds of every gridded sphere; then, slab by
-    /// slab along z and row by row along y, the part of the ray within reach
-    /// (largest gridded radius plus a margin) of that slab and row gives the range
-    /// of x cells to visit. Every cell whose centre slab the ray passes within
-    /// reach of is visited once; cost O(z slabs + rows + cells near the ray).
-    pub(super) fn visit_ray(
-        &self,
-        ray: &Ray,
-        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
-    ) -> ControlFlow<()> {
+    /// The path of a ray or sweep over the gridded spheres ([`Cast::path`]),
+    /// and the union box of the gridded spheres grown by its reach (every
+    /// point of the path within reach of a gridded centre is inside it);
+    /// `None` when nothing is gridded.
+    fn path_of<C: Cast>(&self, cast: &C) -> Option<(Path<'_>, Aabb)> {
         if self.extent.min.cmpgt(self.extent.max).any() {
-            return ControlFlow::Continue(());
+            return None;
         }
-        let g = &self.geom;
+        let (ray, r) = cast.path();
+        let path = Path {
+            g: &self.geom,
+            ray,
+            r,
+        };
         let m = self
             .extent
             .min
             .abs()
             .max(self.extent.max.abs())
             .max_element();
-        let ext = self.extent.grown(g.reach(m) - g.limit);
-        // The ray's interval within `b`, and the range of its coordinate on axis
-        // `a` there, widened by the reach.
-        let span = |b: &Aabb, a: usize| -> Option<(f32, f32, Aabb)> {
-            let (t0, t1) = overlap::ray_aabb(ray, b)?;
-            let p0 = ray.origin[a] as f64 + ray.dir[a] as f64 * t0 as f64;
-            let p1 = ray.origin[a] as f64 + ray.dir[a] as f64 * t1 as f64;
-            let (lo, hi) = (p0.min(p1) as f32, p0.max(p1) as f32);
-            Some((lo - g.reach(lo), hi + g.reach(hi), *b))
+        Some((path, self.extent.grown(path.reach(m) - self.geom.limit)))
+    }
+
+    /// Reports the gridded objects a ray or a sphere sweep touches.
+    ///
+    /// The cast's path (a sweep's segment, [`Cast::path`]) is clipped to the
+    /// bounds of every gridded sphere grown by its reach; then, slab by slab
+    /// along z and row by row along y, the part of the path within reach
+    /// (largest gridded radius plus a margin, plus a sweep's radius) of that
+    /// slab and row gives the range of x cells to visit. Every cell whose
+    /// centre slab the path passes within reach of is visited once; cost
+    /// O(z slabs + rows + cells near the path). A sweep touches an object iff
+    /// its centre is within both radii of the segment, so it is one of them
+    /// [sources: index-queries].
+    pub(super) fn visit_cast<C: Cast>(
+        &self,
+        cast: &C,
+        f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        let Some((path, ext)) = self.path_of(cast) else {
+            return ControlFlow::Continue(());
         };
-        // Restricts `b` on axis `a` to the reach of slab `k`.
-        let restrict = |b: &Aabb, a: usize, k: u32| -> Aabb {
-            let (lo, hi) = g.slab(k, a);
-            let mut r = *b;
-            r.min[a] = r.min[a].max(lo - g.reach(lo));
-            r.max[a] = r.max[a].min(hi + g.reach(hi));
-            r
-        };
-        let Some((z0, z1, _)) = span(&ext, 2) else {
+        let g = &self.geom;
+        let Some((z0, z1, _)) = path.span(&ext, 2) else {
             return ControlFlow::Continue(());
         };
         for k in g.coord(z0, 2)..=g.coord(z1, 2) {
-            let Some((y0, y1, bk)) = span(&restrict(&ext, 2, k), 1) else {
+            let bk = path.restrict(&ext, 2, k);
+            let Some((y0, y1, _)) = path.span(&bk, 1) else {
                 continue;
             };
             for j in g.coord(y0, 1)..=g.coord(y1, 1) {
-                let Some((x0, x1, _)) = span(&restrict(&bk, 1, j), 0) else {
+                let Some((x0, x1, _)) = path.span(&path.restrict(&bk, 1, j), 0) else {
                     continue;
                 };
                 self.visit_row(
-                    ray,
+                    cast,
                     [g.coord(x0, 0), j, k],
                     g.coord(x1, 0),
                     Frustum::ALL_PLANES,
@@ -238,6 +244,110 @@ impl<T> UniformGrid3d<T> {
             }
         }
         ControlFlow::Continue(())
+    }
+
+    /// The first contact of a ray or sweep (smallest `t`, ties by handle)
+    /// among the objects `filter` admits: the large list, then the cells
+    /// near the path (as [`Self::visit_cast`]) slab by slab along the path's
+    /// dominant axis in its direction of travel, stopping before a slab whose
+    /// reach the path enters after the best contact so far. Every object of
+    /// that slab and those beyond has its centre there, so the path comes
+    /// within both radii of it only after that entry (the entry rounded down
+    /// by [`overlap::ray_aabb`]): the answer is the scan's.
+    pub(super) fn first_cast<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
+        let mut best: Option<RayHit> = None;
+        let offer = |best: &mut Option<RayHit>, slot: u32| {
+            let s = &self.spheres[slot as usize];
+            if let Some(t) = cast.contact(s) {
+                if filter.map_or(true, |f| f.interacts(self.filters[slot as usize])) {
+                    RayHit::offer(best, t, self.resolve(slot).0);
+                }
+            }
+        };
+        for &slot in &self.large {
+            offer(&mut best, slot);
+        }
+        if let Some((path, ext)) = self.path_of(cast) {
+            let g = &self.geom;
+            let ad = path.ray.dir.abs();
+            let (a, b, c) = if ad.x >= ad.y && ad.x >= ad.z {
+                (0, 1, 2)
+            } else if ad.y >= ad.z {
+                (1, 2, 0)
+            } else {
+                (2, 0, 1)
+            };
+            if let Some((a0, a1, _)) = path.span(&ext, a) {
+                let (k0, k1) = (g.coord(a0, a), g.coord(a1, a));
+                let back = path.ray.dir[a] < 0.0;
+                for i in 0..=k1 - k0 {
+                    let k = if back { k1 - i } else { k0 + i };
+                    let bk = path.restrict(&ext, a, k);
+                    let Some((b0, b1, t0)) = path.span(&bk, b) else {
+                        continue;
+                    };
+                    if best.is_some_and(|h| h.t < t0) {
+                        break;
+                    }
+                    for j in g.coord(b0, b)..=g.coord(b1, b) {
+                        let Some((c0, c1, _)) = path.span(&path.restrict(&bk, b, j), c) else {
+                            continue;
+                        };
+                        for l in g.coord(c0, c)..=g.coord(c1, c) {
+                            let mut key = [0; 3];
+                            (key[a], key[b], key[c]) = (k, j, l);
+                            for part in self.store.parts(g.index(key)) {
+                                for &slot in part {
+                                    offer(&mut best, slot);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+/// A ray's or sweep's path over a dense grid ([`Cast::path`]): the ray its
+/// centre follows and how far from it the cast reaches.
+#[derive(Clone, Copy)]
+struct Path<'a> {
+    g: &'a Geometry,
+    ray: Ray,
+    r: f32,
+}
+
+impl Path<'_> {
+    /// How far from the path, near coordinate `v`, the centre of a gridded
+    /// sphere the cast touches may lie: the grid's reach plus the cast's.
+    #[inline]
+    fn reach(&self, v: f32) -> f32 {
+        self.g.reach(v) + self.r
+    }
+
+    /// The range of the path's coordinate on axis `a` inside `b`, widened by
+    /// the reach, and the parameter at which the path enters `b` (rounded
+    /// down); `None` if it misses `b`.
+    #[inline]
+    fn span(&self, b: &Aabb, a: usize) -> Option<(f32, f32, f32)> {
+        let ray = &self.ray;
+        let (t0, t1) = overlap::ray_aabb(ray, b)?;
+        let p0 = ray.origin[a] as f64 + ray.dir[a] as f64 * t0 as f64;
+        let p1 = ray.origin[a] as f64 + ray.dir[a] as f64 * t1 as f64;
+        let (lo, hi) = (p0.min(p1) as f32, p0.max(p1) as f32);
+        Some((lo - self.reach(lo), hi + self.reach(hi), t0))
+    }
+
+    /// `b` restricted on axis `a` to the reach of slab `k`.
+    #[inline]
+    fn restrict(&self, b: &Aabb, a: usize, k: u32) -> Aabb {
+        let (lo, hi) = self.g.slab(k, a);
+        let mut rb = *b;
+        rb.min[a] = rb.min[a].max(lo - self.reach(lo));
+        rb.max[a] = rb.max[a].min(hi + self.reach(hi));
+        rb
     }
 }
 
@@ -473,6 +583,26 @@ mod tests {
             ig.sort_unstable();
             hb.sort_unstable();
             assert_eq!(ig, hb);
+        }
+    }
+
+    /// k nearest and sweeps against brute force (see
+    /// [`knn_sweep_suite`](crate::broad::test_util::knn_sweep_suite)).
+    #[test]
+    fn nearest_and_sweeps_match_brute_force() {
+        use crate::broad::test_util::knn_sweep_suite;
+        use crate::broad::{Grid3dConfig, UniformGrid3d};
+        use crate::geom::Aabb;
+        use glam::{vec3, Vec3};
+        for (ext, cell) in [(vec3(30.0, 30.0, 30.0), 3.0), (vec3(60.0, 5.0, 20.0), 1.5)] {
+            let w = Aabb::new(Vec3::ZERO, ext);
+            for seed in 1..3 {
+                let g = UniformGrid3d::with_config(Grid3dConfig {
+                    world: w,
+                    cell_size: cell,
+                });
+                knn_sweep_suite(g.unwrap(), w, seed);
+            }
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The collision world's workloads (issue 13) [sources: world, world-trace]:
 //! `proxima-bench world [--scenes A,B] [--n N] [--arms K] [--frames F] [--seed S]
-//! [--reps R] [--first] [--out DIR] [--no-fcl] [--json]`.
+//! [--reps R] [--first] [--cut-limit C] [--no-coherence] [--out DIR] [--no-fcl]
+//! [--json]`.
 //!
 //! Each scene ([`scenes::SCENES`]: tumble, arm, deep, churn; every object moving
 //! or a tenth) is generated, written as a world trace under `--out` (default
@@ -29,7 +30,7 @@ use scenes::{Scene, Sizes, SCENES};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-const USAGE: &str = "usage: proxima-bench world [--scenes NAME,NAME] [--n N] [--arms K] [--frames F] [--seed S] [--reps R] [--first] [--out DIR] [--no-fcl] [--json]";
+const USAGE: &str = "usage: proxima-bench world [--scenes NAME,NAME] [--n N] [--arms K] [--frames F] [--seed S] [--reps R] [--first] [--cut-limit C] [--no-coherence] [--out DIR] [--no-fcl] [--json]";
 
 struct Args {
     scenes: Vec<String>,
@@ -37,6 +38,9 @@ struct Args {
     seed: u64,
     reps: usize,
     first: bool,
+    /// The world's configuration (`--cut-limit`, `--no-coherence`: what
+    /// coherence saves is measured by turning it off or changing it).
+    config: WorldConfig,
     out: PathBuf,
     fcl: bool,
     json: bool,
@@ -53,6 +57,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         seed: 1,
         reps: 3,
         first: false,
+        config: WorldConfig::default(),
         out: PathBuf::from(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../target/bench-world"
@@ -87,6 +92,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--seed" => a.seed = num(value("--seed")?)?,
             "--reps" => a.reps = num(value("--reps")?)? as usize,
             "--first" => a.first = true,
+            "--cut-limit" => a.config.cut_limit = num(value("--cut-limit")?)? as usize,
+            "--no-coherence" => a.config.coherence = false,
             "--out" => a.out = PathBuf::from(value("--out")?),
             "--no-fcl" => a.fcl = false,
             "--json" => a.json = true,
@@ -157,7 +164,7 @@ fn run(a: &Args) -> Result<bool, String> {
         let scene = scenes::generate(name, &a.out, a.sizes, a.seed)?;
         let trace = a.out.join(format!("{name}.trace"));
         std::fs::write(&trace, scene.trace()).map_err(|e| format!("{}: {e}", trace.display()))?;
-        let ours = ours::run::<Kdop18>(&scene, WorldConfig::default(), a.first, a.reps)?;
+        let ours = ours::run::<Kdop18>(&scene, a.config, a.first, a.reps)?;
         let fcl = bin.as_ref().map(|b| {
             let runs = ["all", "moved"]
                 .iter()
@@ -191,12 +198,22 @@ fn run(a: &Args) -> Result<bool, String> {
                     "triangle_pairs": r.ours.answers.iter().map(|x| x.1).sum::<usize>(),
                     "narrow_pairs": r.ours.counters.narrow_pairs,
                     "coherent_pairs": r.ours.counters.coherent_pairs,
+                    "cut_starts": r.ours.counters.cut_starts,
+                    "nv": r.ours.counters.cost.nv,
+                    "np": r.ours.counters.cost.np,
+                    "nu": r.ours.counters.cost.nu,
                 })
             })
             .collect();
         println!(
             "{}",
-            serde_json::json!({ "first": a.first, "reps": a.reps, "scenes": json })
+            serde_json::json!({
+                "first": a.first,
+                "reps": a.reps,
+                "coherence": a.config.coherence,
+                "cut_limit": a.config.cut_limit,
+                "scenes": json,
+            })
         );
         return Ok(ok);
     }

@@ -25,10 +25,18 @@
 //!    could meet a different witness first; if it finds a contact, the pair is
 //!    run again from the roots so that the witness is the one from the roots).
 //!
-//! Measured with callgrind on the bench's world scenes (`proxima-bench world`):
-//! see `BENCHMARKS.md` ("World") for the instructions per frame with coherence
-//! off, with unchanged pairs skipped only, and with cuts; the cut limit was
-//! chosen there.
+//! Measured with callgrind on the bench's world scenes (`proxima-bench world
+//! --cut-limit C`, instructions per frame; `BENCHMARKS.md`, "World"): reuse 1
+//! pays on every scene, reuse 2 on none of them, so it is off by default
+//! (`cut_limit` 0). A cut of a pair whose objects moved as the scenes move them
+//! (a few hundredths of their size and of a radian per frame) lies deep in the
+//! trees: testing its pairs, with exact moved volumes near the leaves, costs
+//! more than the descent from the roots that it skips, which decides the
+//! disjoint parts high up. With cuts of up to 1024 pairs a frame took 1–24%
+//! more instructions (tumble 6%, a tenth of the tumble moving 12%, arms 2%, a
+//! tenth of the arms 24%, churn 5%, deep 1%), with up to 16,384 pairs 30% more
+//! on the tumble. Cuts pay for motions far smaller than that: a near miss
+//! nudged by 0.2% of its size per frame (the coherence tests).
 
 use super::contacts::{ContactMode, WorldCounters};
 use super::ignore::{key_slots, pair_key};
@@ -40,8 +48,9 @@ use crate::Result;
 use rustc_hash::FxHashMap;
 use std::ops::Range;
 
-/// Default [`WorldConfig::cut_limit`](super::WorldConfig::cut_limit).
-pub(crate) const DEFAULT_CUT_LIMIT: usize = 1024;
+/// Default [`WorldConfig::cut_limit`](super::WorldConfig::cut_limit): no cuts
+/// (they cost instructions on every bench scene, see above).
+pub(crate) const DEFAULT_CUT_LIMIT: usize = 0;
 
 /// Largest accepted cut limit.
 pub(crate) const MAX_CUT_LIMIT: usize = 1 << 20;

@@ -103,6 +103,15 @@ impl<T, S: Store> CellGrid<T, S> {
         if total != expected {
             return fail(format!("{total} references in cells, expected {expected}"));
         }
+        let inert = (self.items.iter())
+            .filter(|(h, _)| self.filters[h.index() as usize].is_inert())
+            .count();
+        if inert != self.inert.get() {
+            return fail(format!(
+                "{inert} inert objects, {} counted",
+                self.inert.get()
+            ));
+        }
         Ok(())
     }
 }

@@ -42,8 +42,8 @@ impl<T> LooseKdTree<T> {
             return fail("span does not cover the world or eps is stale".into());
         }
         if self.root == NIL {
-            if !self.nodes.is_empty() || !self.items.is_empty() {
-                return fail("no root but live nodes or items".into());
+            if !self.nodes.is_empty() || !self.items.is_empty() || self.inert.any() {
+                return fail("no root but live nodes, items or inert count".into());
             }
             return Ok(());
         }
@@ -180,6 +180,16 @@ impl<T> LooseKdTree<T> {
             if !o && self.store.entry[p].is_some() {
                 return fail(format!("dead position {p} not empty"));
             }
+        }
+        // Every other position is empty (checked above): these are the live ones.
+        let inert = (self.store.entry.iter().flatten())
+            .filter(|(_, f, _)| f.is_inert())
+            .count();
+        if inert != self.inert.get() {
+            return fail(format!(
+                "{inert} inert objects but {} counted",
+                self.inert.get()
+            ));
         }
         Ok(())
     }

@@ -98,9 +98,18 @@ impl InertCount {
         self.0 != 0
     }
 
-    /// The count (for `validate`).
-    pub(crate) fn get(self) -> usize {
-        self.0
+    /// `validate`'s check: the count equals the number of inert filters
+    /// among `stored` (every stored object's). O(n).
+    pub(crate) fn check(self, stored: impl Iterator<Item = Filter>) -> crate::Result<()> {
+        let inert = stored.filter(|f| f.is_inert()).count();
+        if inert == self.0 {
+            Ok(())
+        } else {
+            Err(crate::Error::Invalid(format!(
+                "{inert} inert objects but {} counted",
+                self.0
+            )))
+        }
     }
 }
 

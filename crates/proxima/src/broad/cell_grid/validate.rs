@@ -103,15 +103,10 @@ impl<T, S: Store> CellGrid<T, S> {
         if total != expected {
             return fail(format!("{total} references in cells, expected {expected}"));
         }
-        let inert = (self.items.iter())
-            .filter(|(h, _)| self.filters[h.index() as usize].is_inert())
-            .count();
-        if inert != self.inert.get() {
-            return fail(format!(
-                "{inert} inert objects, {} counted",
-                self.inert.get()
-            ));
-        }
-        Ok(())
+        (self.inert).check(
+            self.items
+                .iter()
+                .map(|(h, _)| self.filters[h.index() as usize]),
+        )
     }
 }

@@ -79,15 +79,10 @@ impl<T> UniformGrid3d<T> {
         if spilled != self.store.spill.len() {
             return fail(format!("{spilled} cells need a spill table entry"));
         }
-        let inert = (self.items.iter())
-            .filter(|(h, _)| self.filters[h.index() as usize].is_inert())
-            .count();
-        if inert != self.inert.get() {
-            return fail(format!(
-                "{inert} inert objects, {} counted",
-                self.inert.get()
-            ));
-        }
-        Ok(())
+        (self.inert).check(
+            self.items
+                .iter()
+                .map(|(h, _)| self.filters[h.index() as usize]),
+        )
     }
 }

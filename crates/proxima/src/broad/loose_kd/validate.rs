@@ -182,15 +182,6 @@ impl<T> LooseKdTree<T> {
             }
         }
         // Every other position is empty (checked above): these are the live ones.
-        let inert = (self.store.entry.iter().flatten())
-            .filter(|(_, f, _)| f.is_inert())
-            .count();
-        if inert != self.inert.get() {
-            return fail(format!(
-                "{inert} inert objects but {} counted",
-                self.inert.get()
-            ));
-        }
-        Ok(())
+        (self.inert).check(self.store.entry.iter().flatten().map(|(_, f, _)| *f))
     }
 }

@@ -84,16 +84,7 @@ impl<T> LinearOctree<T> {
         if self.spare.iter().any(|v| !v.is_empty()) {
             return fail("a spare item list is not empty".into());
         }
-        let inert = (self.objects.iter())
-            .filter(|(_, o)| o.filter.is_inert())
-            .count();
-        if inert != self.inert.get() {
-            return fail(format!(
-                "{inert} inert objects, {} counted",
-                self.inert.get()
-            ));
-        }
-        Ok(())
+        self.inert.check(self.objects.iter().map(|(_, o)| o.filter))
     }
 
     fn check_node(&self, i: u32, c: [u32; 3], d: u32, per_depth: &mut [u32]) -> Result<Sub> {

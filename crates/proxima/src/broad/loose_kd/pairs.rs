@@ -475,10 +475,25 @@ impl<T> LooseKdTree<T> {
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let node = &self.nodes[n];
+        let start = node.start as usize;
         let own = &self.store.sphere[node.range()];
         let base = b.c.len();
+        if !self.inert.any() {
+            // Every object takes part: the own objects are read in place (one
+            // sphere load each; the loop below rebuilds them from the carried
+            // set, which cost W1 100k 5% more instructions).
+            b.c.push_node(start, own, |_, _| true);
+            if own.len() > 1 && b.c.len() - active >= SWEEP_MIN {
+                return self.sweep(active, base, node.axis as usize, b, f);
+            }
+            let c = &b.c;
+            for (i, y) in own.iter().enumerate() {
+                c.scan(active, base + i, y, |k| self.report_at(c, k, start + i, f))?;
+            }
+            return ControlFlow::Continue(());
+        }
         // Inert objects stay out: neither carried down nor tested here.
-        b.c.push_node(node.start as usize, own, |p, _| self.pairable(p));
+        b.c.push_node(start, own, |p, _| self.pairable(p));
         let end = b.c.len();
         if end - base > 1 && end - active >= SWEEP_MIN {
             self.sweep(active, base, node.axis as usize, b, f)?;

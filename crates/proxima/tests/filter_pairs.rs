@@ -14,7 +14,6 @@ use proxima_harness::oracle::{make_index, pair_ids};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::collections::HashMap;
-use std::ops::ControlFlow;
 
 /// Operations per index kind, layout and seed.
 const OPS: usize = 2500;

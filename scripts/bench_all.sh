@@ -14,6 +14,11 @@ $B w2 --n 100000 --frames 30 --json > $D/w2-100k.json 2>/dev/null
 $B w3 --n 100000 --frames 30 --json > $D/w3-100k.json 2>/dev/null
 $B w9 --n 100000 --frames 30 --json > $D/w9-100k.json 2>/dev/null
 uptime >> $D/load.txt
+# Issue #14 part 3: W1 100k with half the objects in a group that collides with
+# nothing (`--inert 0.5`), beside the unfiltered run above; parry3d filters in
+# its pair callback. Compare pairs_ms_median with w1-100k.json.
+$B w1 --n 100000 --frames 30 --inert 0.5 --json > $D/w1-100k-inert0.5.json 2>/dev/null
+uptime >> $D/load.txt
 for t in 1 2; do $B w1 --n 100000 --frames 30 --clock wall --threads $t --only LooseKdTree,UniformGrid3d,parry3d --json > $D/w1-100k-wall-t$t.json 2>/dev/null; done
 $B w4 > $D/w4.txt 2>/dev/null
 $B w4 --json > $D/w4.json 2>/dev/null

@@ -1,4 +1,4 @@
-//! `proxima-bench w1|w2|w3|w9 [--n N] [--frames F] [--seed S] [--only A,B] [--clock cpu|wall] [--threads K] [--json]`
+//! `proxima-bench w1|w2|w3|w9 [--n N] [--frames F] [--seed S] [--only A,B] [--clock cpu|wall] [--threads K] [--inert F] [--json]`
 //! `proxima-bench w5 …` (see `proxima_bench::w5`), `w5-distance …` (`proxima_bench::w5_distance`)
 //! `proxima-bench w7 …` (k nearest, `proxima_bench::w7`), `w8 …` (sphere sweeps, `proxima_bench::w8`)
 //! `proxima-bench world …` (see `proxima_bench::world`)
@@ -11,7 +11,11 @@
 //! skipped above 20k objects. Times are the running thread's CPU time by default
 //! (`--clock wall` for elapsed time): this machine is shared. `--threads K`
 //! (default 1) counts pairs with the parallel search of the structures that
-//! have one, in a K-thread pool; with K > 1 the clock is wall time.
+//! have one, in a K-thread pool; with K > 1 the clock is wall time. `--inert F`
+//! (a fraction in [0, 1], default 0) puts that fraction of the objects in a
+//! group that collides with nothing (`inert_filters`); pairs are then counted
+//! among the others only, by every structure its own way (Proxima's indices
+//! prune by filter inside the search, parry3d filters in its pair callback).
 
 use proxima_bench::registry::{self, QUADRATIC_LIMIT};
 use proxima_bench::report;
@@ -20,7 +24,7 @@ use proxima_harness::workloads::Kind;
 use std::process::ExitCode;
 
 const USAGE: &str =
-    "usage: proxima-bench w1|w2|w3|w9 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--threads K] [--json]\n       proxima-bench w4 [--help]\n       proxima-bench w5 [--help]\n       proxima-bench w5-distance [--help]\n       proxima-bench w6 [--help]\n       proxima-bench w7 [--help]\n       proxima-bench w8 [--help]\n       proxima-bench world [--help]\n       proxima-bench chart FILE.json... --out FILE.svg [--metric NAME] [--title T]";
+    "usage: proxima-bench w1|w2|w3|w9 [--n N] [--frames F] [--seed S] [--only NAME,NAME] [--clock cpu|wall] [--threads K] [--inert F] [--json]\n       proxima-bench w4 [--help]\n       proxima-bench w5 [--help]\n       proxima-bench w5-distance [--help]\n       proxima-bench w6 [--help]\n       proxima-bench w7 [--help]\n       proxima-bench w8 [--help]\n       proxima-bench world [--help]\n       proxima-bench chart FILE.json... --out FILE.svg [--metric NAME] [--title T]";
 
 struct Args {
     kind: Kind,
@@ -30,6 +34,7 @@ struct Args {
     only: Vec<String>,
     clock: Clock,
     threads: usize,
+    inert: f64,
     json: bool,
 }
 
@@ -44,6 +49,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         only: Vec::new(),
         clock: Clock::ThreadCpu,
         threads: 1,
+        inert: 0.0,
         json: false,
     };
     while let Some(flag) = it.next() {
@@ -61,6 +67,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             }
             "--clock" => a.clock = Clock::parse(&value("--clock")?)?,
             "--threads" => a.threads = num(&value("--threads")?)?,
+            "--inert" => a.inert = num(&value("--inert")?)?,
             "--json" => a.json = true,
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument {other:?}")),
@@ -68,6 +75,12 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     }
     if a.frames == 0 {
         return Err("--frames must be at least 1".into());
+    }
+    if !(0.0..=1.0).contains(&a.inert) {
+        return Err(format!(
+            "--inert takes a fraction in [0, 1], not {}",
+            a.inert
+        ));
     }
     if a.threads == 0 {
         return Err("--threads must be at least 1".into());
@@ -130,28 +143,31 @@ fn main() -> ExitCode {
         args.frames,
         args.clock,
         args.threads,
+        args.inert,
         |e| eprintln!("running {} ...", e.name),
     );
     if args.json {
+        // A filtered run names its workload `w1-inert0.5`, so that its rows
+        // never mix with the unfiltered ones in a chart.
+        let name = if args.inert > 0.0 {
+            format!("{}-inert{}", args.kind.name(), args.inert)
+        } else {
+            args.kind.name().to_string()
+        };
         print!(
             "{}",
-            report::json(
-                args.kind.name(),
-                args.seed,
-                args.frames,
-                args.clock,
-                &results
-            )
+            report::json(&name, args.seed, args.frames, args.clock, &results)
         );
     } else {
         println!(
-            "{} n={} frames={} seed={} clock={} threads={} (medians per frame; pair counts checked equal on every frame)",
+            "{} n={} frames={} seed={} clock={} threads={} inert={} (medians per frame; pair counts checked equal on every frame)",
             args.kind.name(),
             args.n,
             args.frames,
             args.seed,
             args.clock.name(),
-            args.threads
+            args.threads,
+            args.inert
         );
         print!("{}", report::table(&results));
         if !skipped.is_empty() {

@@ -10,7 +10,11 @@
 //!   depth-first); or a fresh `from_leaves` over the new AABBs;
 //! - pairs: `traverse_bvtt_single_tree::<false>` (the tree against itself, every
 //!   leaf pair whose AABBs overlap), each candidate filtered by the exact closed
-//!   sphere–sphere test of `proxima::geom::overlap`, so the count is comparable.
+//!   sphere–sphere test of `proxima::geom::overlap`, so the count is comparable;
+//! - collision filters (`--inert`): parry's `Bvh` stores no filter bits, so the
+//!   pair callback drops the pairs whose filters do not interact, before the
+//!   sphere test — the way rapier applies `InteractionGroups` to the broad
+//!   phase's pairs (its documented way: parry has no pruning by groups).
 //!
 //! Change detection (a fattened leaf margin plus `CHANGE_DETECTION = true`) is what
 //! rapier uses to report only *new* pairs; the workloads ask for *all* pairs every
@@ -20,6 +24,7 @@ use crate::structure::Structure;
 use parry3d::bounding_volume::Aabb as PAabb;
 use parry3d::math::Vector;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhNodeWide, BvhWorkspace};
+use proxima::broad::Filter;
 use proxima::geom::{overlap, Sphere};
 
 /// How the BVH is maintained from one frame to the next: the three documented
@@ -63,6 +68,8 @@ pub struct ParryBvh {
     spheres: Vec<Sphere>,
     /// The leaves' AABBs, kept for [`ParryMode::Rebuild`] (no allocation per frame).
     aabbs: Vec<PAabb>,
+    /// Leaf `i`'s collision filter; empty when none was set (no test at all).
+    filters: Vec<Filter>,
     mode: ParryMode,
 }
 
@@ -82,18 +89,33 @@ impl ParryBvh {
             workspace: BvhWorkspace::default(),
             spheres: Vec::new(),
             aabbs: Vec::new(),
+            filters: Vec::new(),
             mode,
         }
     }
 
     /// Calls `f(a, b)` once for every pair of leaves whose spheres overlap
     /// (closed test); the pair search behind [`Structure::count_pairs`].
+    /// With filters set, only pairs whose filters interact (tested first).
     pub fn for_each_pair(&mut self, mut f: impl FnMut(u32, u32)) {
         let spheres = &self.spheres;
+        if self.filters.is_empty() {
+            self.bvh
+                .traverse_bvtt_single_tree::<false>(&mut self.workspace, &mut |a, b| {
+                    if overlap::sphere_sphere(&spheres[a as usize], &spheres[b as usize]) {
+                        f(a, b);
+                    }
+                });
+            return;
+        }
+        let filters = &self.filters;
         self.bvh
             .traverse_bvtt_single_tree::<false>(&mut self.workspace, &mut |a, b| {
-                if overlap::sphere_sphere(&spheres[a as usize], &spheres[b as usize]) {
-                    f(a, b);
+                let (a, b) = (a as usize, b as usize);
+                if filters[a].interacts(filters[b])
+                    && overlap::sphere_sphere(&spheres[a], &spheres[b])
+                {
+                    f(a as u32, b as u32);
                 }
             });
     }
@@ -104,6 +126,10 @@ impl Structure for ParryBvh {
         self.spheres = spheres.to_vec();
         self.aabbs = spheres.iter().map(aabb).collect();
         self.bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &self.aabbs);
+    }
+
+    fn set_filters(&mut self, filters: &[Filter]) {
+        self.filters = filters.to_vec();
     }
 
     fn update(&mut self, spheres: &[Sphere]) {
@@ -146,6 +172,7 @@ impl Structure for ParryBvh {
             + self.bvh.total_memory_size()
             + side
             + self.spheres.capacity() * std::mem::size_of::<Sphere>()
+            + self.filters.capacity() * std::mem::size_of::<Filter>()
     }
 }
 

@@ -3,6 +3,7 @@
 
 use crate::registry::Entry;
 use crate::structure::Structure;
+use proxima::broad::Filter;
 use proxima_harness::workloads::{Kind, Workload};
 use std::time::{Duration, Instant};
 
@@ -103,6 +104,27 @@ impl PairLedger {
     }
 }
 
+/// The filters of `--inert F`: object `i` is inert with probability `F`
+/// (decided by a hash of `i`, so the same objects in every structure and run),
+/// in group 2 whose mask is empty — a group that collides with nothing; the
+/// others are group 1 colliding with group 1. An empty list for `F <= 0` (no
+/// filter set at all: the unfiltered run).
+pub fn inert_filters(n: usize, inert: f64) -> Vec<Filter> {
+    if inert <= 0.0 {
+        return Vec::new();
+    }
+    (0..n as u64)
+        .map(|i| {
+            let u = (i.wrapping_add(1).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 11) as f64;
+            if u / ((1u64 << 53) as f64) < inert {
+                Filter::new(2, 0)
+            } else {
+                Filter::new(1, 1)
+            }
+        })
+        .collect()
+}
+
 /// What one structure measured on one workload.
 #[derive(Clone, Debug)]
 pub struct Measurement {
@@ -181,13 +203,14 @@ pub fn measure(
     clock: Clock,
     ledger: &mut PairLedger,
 ) -> Measurement {
-    measure_threads(entry, kind, n, seed, frames, clock, 1, ledger)
+    measure_threads(entry, kind, n, seed, frames, clock, 1, 0.0, ledger)
 }
 
 /// [`measure`] with `threads` threads for the pairs: with `threads > 1`, pairs
 /// are counted by [`Structure::count_pairs_par`] in a pool of that many threads
 /// (time it with [`Clock::Wall`]: the work runs on the pool's threads, not the
-/// caller's).
+/// caller's). With `inert > 0`, the objects get [`inert_filters`] after the
+/// build (not timed), and only interacting pairs are counted.
 #[allow(clippy::too_many_arguments)]
 pub fn measure_threads(
     entry: &Entry,
@@ -197,6 +220,7 @@ pub fn measure_threads(
     frames: usize,
     clock: Clock,
     threads: usize,
+    inert: f64,
     ledger: &mut PairLedger,
 ) -> Measurement {
     let pool = (threads > 1).then(|| {
@@ -208,6 +232,10 @@ pub fn measure_threads(
     let mut w = Workload::new(kind, n, seed);
     let mut s: Box<dyn Structure> = entry.make(&w.scene());
     let ((), build) = clock.time(|| s.build(&w.spheres));
+    let filters = inert_filters(n, inert);
+    if !filters.is_empty() {
+        s.set_filters(&filters);
+    }
     let mut m = Measurement {
         name: entry.name,
         mode: entry.mode,
@@ -246,10 +274,11 @@ pub fn measure_all(
     clock: Clock,
     progress: impl FnMut(&Entry),
 ) -> Vec<Measurement> {
-    measure_all_threads(entries, kind, n, seed, frames, clock, 1, progress)
+    measure_all_threads(entries, kind, n, seed, frames, clock, 1, 0.0, progress)
 }
 
-/// [`measure_all`] with `threads` threads for the pairs (see [`measure_threads`]).
+/// [`measure_all`] with `threads` threads for the pairs and a fraction `inert`
+/// of inert objects (see [`measure_threads`]).
 #[allow(clippy::too_many_arguments)]
 pub fn measure_all_threads(
     entries: &[Entry],
@@ -259,6 +288,7 @@ pub fn measure_all_threads(
     frames: usize,
     clock: Clock,
     threads: usize,
+    inert: f64,
     mut progress: impl FnMut(&Entry),
 ) -> Vec<Measurement> {
     let mut ledger = PairLedger::new();
@@ -267,7 +297,61 @@ pub fn measure_all_threads(
         .filter(|e| e.runs_on(n))
         .map(|e| {
             progress(e);
-            measure_threads(e, kind, n, seed, frames, clock, threads, &mut ledger)
+            measure_threads(e, kind, n, seed, frames, clock, threads, inert, &mut ledger)
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::registry;
+    use proxima::geom::overlap;
+
+    /// `--inert 0.5`: every structure (Proxima's six indices, parry3d in every
+    /// mode) counts exactly the pairs of non-inert objects, frame after frame,
+    /// as a direct all-pairs count with the filters says; and the filters
+    /// matter (about a quarter of the unfiltered pairs are left).
+    #[test]
+    fn inert_objects_drop_out_of_every_structure_s_pairs() {
+        let (n, frames, seed) = (1500, 4, 7);
+        let f = inert_filters(n, 0.5);
+        let inert = f.iter().filter(|f| f.is_inert()).count();
+        assert!((600..900).contains(&inert), "{inert} of {n} inert");
+        let entries = registry::entries();
+        let all = measure_all_threads(
+            &entries,
+            Kind::W1,
+            n,
+            seed,
+            frames,
+            Clock::Wall,
+            1,
+            0.5,
+            |_| {},
+        );
+        assert_eq!(all.len(), entries.len());
+        let (mut want, mut unfiltered) = (0u64, 0u64);
+        let mut w = Workload::new(Kind::W1, n, seed);
+        for _ in 0..frames {
+            w.step();
+            let s = &w.spheres;
+            for i in 0..n {
+                for j in i + 1..n {
+                    if overlap::sphere_sphere(&s[i], &s[j]) {
+                        unfiltered += 1;
+                        want += f[i].interacts(f[j]) as u64;
+                    }
+                }
+            }
+        }
+        assert!(
+            4 * want < 2 * unfiltered && 8 * want > unfiltered,
+            "{want} of {unfiltered}"
+        );
+        for m in &all {
+            assert_eq!(m.pair_total, want, "{} {}", m.name, m.mode);
+        }
+        assert!(inert_filters(n, 0.0).is_empty());
+    }
 }

@@ -1,7 +1,7 @@
 //! One object-safe interface over everything the benchmarks run: Proxima's indices
 //! (through [`Indexed`], over the library's [`AnyIndex`]) and the peers.
 
-use proxima::broad::{AnyIndex, ParallelPairs, SpatialIndex};
+use proxima::broad::{AnyIndex, Filter, ParallelPairs, SpatialIndex};
 use proxima::geom::Sphere;
 use proxima::Handle;
 
@@ -11,6 +11,11 @@ use proxima::Handle;
 pub trait Structure {
     /// Inserts every sphere (object `i` = `spheres[i]`) into the empty structure.
     fn build(&mut self, spheres: &[Sphere]);
+
+    /// Gives object `i` the collision filter `filters[i]` (after `build`; same
+    /// length), the way the structure's users apply filters: from then on
+    /// [`Structure::count_pairs`] counts only pairs whose filters interact.
+    fn set_filters(&mut self, filters: &[Filter]);
 
     /// Moves every object to its new sphere (same length and order as `build`).
     fn update(&mut self, spheres: &[Sphere]);
@@ -64,6 +69,15 @@ impl Structure for Indexed {
                 .insert(*s, i as u32)
                 .unwrap_or_else(|e| panic!("insert of sphere {i} {s:?} failed: {e}"));
             self.handles.push(h);
+        }
+    }
+
+    /// `set_filter` per object: the index prunes its pair search by them.
+    fn set_filters(&mut self, filters: &[Filter]) {
+        for (&h, &f) in self.handles.iter().zip(filters) {
+            self.index
+                .set_filter(h, f)
+                .unwrap_or_else(|e| panic!("set_filter failed: {e}"));
         }
     }
 

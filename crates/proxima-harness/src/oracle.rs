@@ -667,7 +667,9 @@ fn hit_ids<I: SpatialIndex<u64>>(index: &I, r: &Ray) -> Vec<(u64, u32)> {
     v
 }
 
-fn pair_ids<I: SpatialIndex<u64>>(index: &I) -> Vec<(u64, u64)> {
+/// The pairs of `index` as sorted `(smaller id, larger id)` (the payloads);
+/// panics if a pair is reported twice.
+pub fn pair_ids<I: SpatialIndex<u64>>(index: &I) -> Vec<(u64, u64)> {
     let mut v = Vec::new();
     let _ = index.for_each_pair(|_, a, _, b| {
         v.push(if a < b { (*a, *b) } else { (*b, *a) });

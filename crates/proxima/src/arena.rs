@@ -81,8 +81,8 @@ impl<V> Arena<V> {
         self.len == 0
     }
 
-    /// Number of slots (live or free): the capacity in use.
-    #[cfg(test)]
+    /// Number of slots (live or free): the capacity in use (slot indices are
+    /// below it).
     pub fn slot_count(&self) -> usize {
         self.slots.len()
     }

@@ -99,6 +99,17 @@ impl<T: Send + Sync> SpatialIndex<T> for BruteForce<T> {
     }
 }
 
+impl<T> BruteForce<T> {
+    /// The objects that can interact with something: the pair searches'
+    /// candidates (inert ones, [`Filter::is_inert`], never enter them). O(n).
+    fn interacting(&self) -> Vec<(Handle, &(Sphere, Filter, T))> {
+        self.items
+            .iter()
+            .filter(|(_, (_, f, _))| !f.is_inert())
+            .collect()
+    }
+}
+
 impl<T> Walk<T> for BruteForce<T> {
     fn walk<Q: Selection + ?Sized>(
         &self,
@@ -161,7 +172,7 @@ impl<T> Walk<T> for BruteForce<T> {
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let all: Vec<_> = self.items.iter().collect();
+        let all = self.interacting();
         for (i, (ha, (sa, fa, va))) in all.iter().enumerate() {
             for (hb, (sb, fb, vb)) in &all[i + 1..] {
                 if fa.interacts(*fb) && overlap::sphere_sphere(sa, sb) {
@@ -185,7 +196,7 @@ impl<T: Send + Sync> super::ParallelPairs<T> for BruteForce<T> {
         R: Fn(A, A) -> A + Sync + Send,
     {
         use rayon::prelude::*;
-        let all: Vec<_> = self.items.iter().collect();
+        let all = self.interacting();
         (0..all.len())
             .into_par_iter()
             .fold(&init, |mut acc, i| {

@@ -65,6 +65,54 @@ impl Default for Filter {
     }
 }
 
+/// How many stored objects are inert ([`Filter::is_inert`]): an index keeps
+/// one so that its pair search leaves inert objects out only when there are
+/// some, and an index without any runs the unchanged loops (no filter read per
+/// object). Updated on insert, remove and filter change, O(1) each.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct InertCount(usize);
+
+impl InertCount {
+    /// Counts an object stored with filter `f`.
+    #[inline]
+    pub(crate) fn add(&mut self, f: Filter) {
+        self.0 += f.is_inert() as usize;
+    }
+
+    /// Uncounts an object removed with filter `f`.
+    #[inline]
+    pub(crate) fn sub(&mut self, f: Filter) {
+        self.0 -= f.is_inert() as usize;
+    }
+
+    /// An object's filter changed from `old` to `new`.
+    #[inline]
+    pub(crate) fn change(&mut self, old: Filter, new: Filter) {
+        self.sub(old);
+        self.add(new);
+    }
+
+    /// Whether some stored object is inert.
+    #[inline]
+    pub(crate) fn any(self) -> bool {
+        self.0 != 0
+    }
+
+    /// `validate`'s check: the count equals the number of inert filters
+    /// among `stored` (every stored object's). O(n).
+    pub(crate) fn check(self, stored: impl Iterator<Item = Filter>) -> crate::Result<()> {
+        let inert = stored.filter(|f| f.is_inert()).count();
+        if inert == self.0 {
+            Ok(())
+        } else {
+            Err(crate::Error::Invalid(format!(
+                "{inert} inert objects but {} counted",
+                self.0
+            )))
+        }
+    }
+}
+
 /// What an index walk reports besides the shape test: `()` everything (no
 /// code at all), a [`Filter`] the objects whose filter interacts with it,
 /// skipping the subtrees whose OR-ed filter bits cannot

@@ -4,7 +4,7 @@
 
 use super::{Object, WorldConfig};
 use crate::arena::Arena;
-use crate::broad::{AnyIndex, IndexKind, Query, SceneHint, SpatialIndex};
+use crate::broad::{AnyIndex, Filter, IndexKind, Query, SceneHint, SpatialIndex};
 use crate::geom::{overlap, Aabb, Relation, Sphere};
 use crate::{Handle, Result};
 use std::ops::ControlFlow;
@@ -61,7 +61,8 @@ impl Broad {
         let mut index: AnyIndex<u32> = kind.build(&hint)?;
         let mut handles = Vec::with_capacity(objects.len());
         for (h, o) in objects.iter() {
-            handles.push(index.insert(o.sphere, h.index())?);
+            // With its filter: the index's pair search prunes by it.
+            handles.push(index.insert_with_filter(o.sphere, o.filter, h.index())?);
         }
         let grow = hint.world.extent() * 0.5;
         self.drift_box = Some(Aabb::new(hint.world.min - grow, hint.world.max + grow));
@@ -79,12 +80,26 @@ impl Broad {
         Ok(())
     }
 
-    /// Stores a sphere if the index is built; its handle there.
-    pub(crate) fn insert(&mut self, s: Sphere, slot: u32) -> Result<Option<Handle>> {
+    /// Stores a sphere with the object's filter if the index is built; its
+    /// handle there.
+    pub(crate) fn insert(
+        &mut self,
+        s: Sphere,
+        filter: Filter,
+        slot: u32,
+    ) -> Result<Option<Handle>> {
         match &mut self.index {
-            Some(i) => Ok(Some(i.insert(s, slot)?)),
+            Some(i) => Ok(Some(i.insert_with_filter(s, filter, slot)?)),
             None => Ok(None),
         }
+    }
+
+    /// Gives the index's copy of an object the object's new filter.
+    pub(crate) fn set_filter(&mut self, h: Handle, filter: Filter) -> Result<()> {
+        if let Some(i) = &mut self.index {
+            i.set_filter(h, filter)?;
+        }
+        Ok(())
     }
 
     pub(crate) fn remove(&mut self, h: Handle) -> Result<()> {

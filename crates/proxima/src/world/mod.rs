@@ -268,7 +268,7 @@ impl<T, BV: BoundingVolume> World<T, BV> {
         let posed = Posed::new(&shape, &pose)?;
         self.objects.check_room()?;
         let slot = self.objects.next_handle().index();
-        let broad = self.broad.insert(posed.sphere, slot)?;
+        let broad = self.broad.insert(posed.sphere, filter, slot)?;
         let drift = self
             .broad
             .is_drifted(&posed.sphere, self.config.bounds.is_some());
@@ -371,6 +371,9 @@ impl<T, BV: BoundingVolume> World<T, BV> {
         if o.filter != filter {
             o.filter = filter;
             o.stamp = epoch;
+            if let Some(b) = o.broad {
+                self.broad.set_filter(b, filter)?;
+            }
         }
         Ok(())
     }

@@ -15,7 +15,7 @@ fn fail<T>(msg: String) -> Result<T> {
 impl<T, BV: BoundingVolume> World<T, BV> {
     /// Checks the world's invariants: the arena; each object's inverse pose and
     /// broad sphere recomputed from its pose and shape; the index (once built)
-    /// holding exactly the live objects with those spheres, and its own
+    /// holding exactly the live objects with those spheres and filters, and its own
     /// invariants; the drift count; the ignored pairs naming live objects, each
     /// once, with consistent partner lists; stamps and insertion numbers; the
     /// coherence cache's ranges. O(n + index + cache). Returns
@@ -49,6 +49,9 @@ impl<T, BV: BoundingVolume> World<T, BV> {
                         return fail(format!(
                             "object {h:?}: the index holds {s:?} for slot {slot}"
                         ));
+                    }
+                    if index.filter(b)? != o.filter {
+                        return fail(format!("object {h:?}: the index holds another filter"));
                     }
                 }
                 _ => return fail(format!("object {h:?}: index handle out of step")),

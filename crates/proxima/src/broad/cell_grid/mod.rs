@@ -31,6 +31,7 @@ pub(crate) use hashed::Hashed;
 pub(crate) use store::Store;
 
 use crate::arena::Arena;
+use crate::broad::filter::InertCount;
 use crate::broad::Filter;
 use crate::geom::Sphere;
 use crate::{Handle, Result};
@@ -75,6 +76,9 @@ pub(crate) struct CellGrid<T, S: Store> {
     /// Slot → collision filter of the live object there (read only for pairs
     /// that overlap and for filtered queries, so the spheres stay dense).
     filters: Vec<Filter>,
+    /// Inert objects stored: while there are some, the pair search leaves
+    /// them out of each cell's list (see `pairs.rs`).
+    inert: InertCount,
     /// Growing bounds on the gridded spheres, for the cells' loose boxes.
     reach: Reach,
     /// Slots of the oversized objects.
@@ -91,6 +95,7 @@ impl<T, S: Store> CellGrid<T, S> {
             items: Arena::new(),
             spheres: Vec::new(),
             filters: Vec::new(),
+            inert: InertCount::default(),
             reach: Reach::default(),
             oversized: Vec::new(),
             refs: 0,
@@ -153,12 +158,14 @@ impl<T, S: Store> CellGrid<T, S> {
         }
         self.spheres[slot as usize] = sphere;
         self.filters[slot as usize] = filter;
+        self.inert.add(filter);
         Ok(h)
     }
 
     /// Removes an object. O(cells covered × references per cell).
     pub fn remove(&mut self, handle: Handle) -> Result<T> {
         let item = self.items.remove(handle)?;
+        self.inert.sub(self.filters[handle.index() as usize]);
         self.unplace(handle.index(), item.place);
         if self.items.is_empty() {
             self.reach = Reach::default();
@@ -195,7 +202,8 @@ impl<T, S: Store> CellGrid<T, S> {
     /// Replaces the filter of a live handle. O(1).
     pub fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
         self.items.get(handle)?;
-        self.filters[handle.index() as usize] = filter;
+        let old = std::mem::replace(&mut self.filters[handle.index() as usize], filter);
+        self.inert.change(old, filter);
         Ok(())
     }
 
@@ -221,6 +229,7 @@ impl<T, S: Store> CellGrid<T, S> {
         self.items.clear();
         self.spheres = Vec::new();
         self.filters = Vec::new();
+        self.inert = InertCount::default();
         self.reach = Reach::default();
         self.oversized = Vec::new();
         self.refs = 0;

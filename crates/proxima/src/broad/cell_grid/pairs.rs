@@ -1,7 +1,8 @@
 //! All overlapping pairs: within each occupied cell, then the oversized objects.
 
+use super::keys::Key;
 use super::list::Packed;
-use super::store::Store;
+use super::store::{Entries, Store};
 use super::CellGrid;
 use crate::geom::{overlap, Sphere};
 use crate::Handle;
@@ -16,7 +17,10 @@ fn candidate(a: &Sphere, b: &Sphere) -> bool {
 
 impl<T, S: Store> CellGrid<T, S> {
     /// Calls `f` once per overlapping pair whose filters interact (checked
-    /// after the exact test: only overlapping pairs read the filters).
+    /// after the exact test: only overlapping pairs read the filters). Inert
+    /// objects never enter it [sources: index-queries]: while some are stored,
+    /// each cell's list is copied without them first (the copy is O(k), the
+    /// tests it saves O(k²)), and inert oversized objects are skipped.
     ///
     /// Gridded pairs: two overlapping objects have overlapping footprints, so
     /// they share at least one cell. A pair found in cell `key` is reported only
@@ -38,35 +42,26 @@ impl<T, S: Store> CellGrid<T, S> {
         &self,
         mut f: impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        self.store.cells(|key, es| {
-            if es.len() < 2 {
-                return ControlFlow::Continue(());
-            }
-            for (i, ea) in es.iter().enumerate() {
-                let sa = &self.spheres[ea.slot as usize];
-                let la = ea.keys.lo();
-                for eb in &es[i + 1..] {
-                    let sb = &self.spheres[eb.slot as usize];
-                    if candidate(sa, sb)
-                        && {
-                            let lb = eb.keys.lo();
-                            (0..S::AXES).all(|a| la[a].max(lb[a]) == key[a])
-                        }
-                        && overlap::sphere_sphere(sa, sb)
-                        && self.filters[ea.slot as usize].interacts(self.filters[eb.slot as usize])
-                    {
-                        let (ha, va) = self.resolve(ea.slot);
-                        let (hb, vb) = self.resolve(eb.slot);
-                        f(ha, va, hb, vb)?;
-                    }
-                }
-            }
-            ControlFlow::Continue(())
-        })?;
+        if self.inert.any() {
+            // Inert objects leave each cell's list before its k² tests (one
+            // filter read per reference).
+            let mut live = Vec::new();
+            self.store.cells(|key, es| {
+                live.clear();
+                live.extend((es.iter()).filter(|e| !self.filters[e.slot as usize].is_inert()));
+                self.cell_pairs(key, &live, &mut f)
+            })?;
+        } else {
+            self.store
+                .cells(|key, es| self.cell_pairs(key, es, &mut f))?;
+        }
         for (i, &a) in self.oversized.iter().enumerate() {
+            let fa = self.filters[a as usize];
+            if fa.is_inert() {
+                continue;
+            }
             let (ha, va) = self.resolve(a);
             let sa = &self.spheres[a as usize];
-            let fa = self.filters[a as usize];
             for &b in &self.oversized[i + 1..] {
                 if fa.interacts(self.filters[b as usize])
                     && overlap::sphere_sphere(sa, &self.spheres[b as usize])
@@ -83,6 +78,39 @@ impl<T, S: Store> CellGrid<T, S> {
                     ControlFlow::Continue(())
                 }
             })?;
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// The pairs first met in cell `key`, among its references `es`.
+    #[inline]
+    fn cell_pairs(
+        &self,
+        key: Key,
+        es: Entries<'_, S::Packed>,
+        f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        if es.len() < 2 {
+            return ControlFlow::Continue(());
+        }
+        for (i, ea) in es.iter().enumerate() {
+            let sa = &self.spheres[ea.slot as usize];
+            let la = ea.keys.lo();
+            for eb in &es[i + 1..] {
+                let sb = &self.spheres[eb.slot as usize];
+                if candidate(sa, sb)
+                    && {
+                        let lb = eb.keys.lo();
+                        (0..S::AXES).all(|a| la[a].max(lb[a]) == key[a])
+                    }
+                    && overlap::sphere_sphere(sa, sb)
+                    && self.filters[ea.slot as usize].interacts(self.filters[eb.slot as usize])
+                {
+                    let (ha, va) = self.resolve(ea.slot);
+                    let (hb, vb) = self.resolve(eb.slot);
+                    f(ha, va, hb, vb)?;
+                }
+            }
         }
         ControlFlow::Continue(())
     }

@@ -103,6 +103,10 @@ impl<T, S: Store> CellGrid<T, S> {
         if total != expected {
             return fail(format!("{total} references in cells, expected {expected}"));
         }
-        Ok(())
+        (self.inert).check(
+            self.items
+                .iter()
+                .map(|(h, _)| self.filters[h.index() as usize]),
+        )
     }
 }

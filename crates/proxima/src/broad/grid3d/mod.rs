@@ -15,6 +15,7 @@ mod query;
 mod validate;
 
 use crate::arena::Arena;
+use crate::broad::filter::InertCount;
 use crate::broad::walk::{walk_methods, Walk};
 use crate::broad::{Filter, IndexKind, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Sphere};
@@ -111,6 +112,9 @@ pub struct UniformGrid3d<T> {
     /// Slot → collision filter (read for reported pairs and filtered queries
     /// only, so the scans' sphere array stays dense).
     filters: Vec<Filter>,
+    /// Inert objects stored: while there are some, the pair scan leaves them
+    /// out of its rows (see `pairs.rs`).
+    inert: InertCount,
     /// Slots of the large objects.
     large: Vec<u32>,
     /// Union of the gridded spheres' boxes since the grid was created, cleared or
@@ -139,6 +143,7 @@ impl<T> UniformGrid3d<T> {
             locs: Vec::new(),
             spheres: Vec::new(),
             filters: Vec::new(),
+            inert: InertCount::default(),
             large: Vec::new(),
             extent: Aabb::EMPTY,
         })
@@ -238,11 +243,13 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
         self.locs[slot as usize] = loc;
         self.spheres[slot as usize] = sphere;
         self.filters[slot as usize] = filter;
+        self.inert.add(filter);
         Ok(h)
     }
 
     fn remove(&mut self, handle: Handle) -> Result<T> {
         let value = self.items.remove(handle)?;
+        self.inert.sub(self.filters[handle.index() as usize]);
         self.unplace(self.locs[handle.index() as usize]);
         if self.items.is_empty() {
             self.extent = Aabb::EMPTY;
@@ -289,7 +296,8 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
 
     fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
         self.items.get(handle)?;
-        self.filters[handle.index() as usize] = filter;
+        let old = std::mem::replace(&mut self.filters[handle.index() as usize], filter);
+        self.inert.change(old, filter);
         Ok(())
     }
 
@@ -306,6 +314,7 @@ impl<T: Send + Sync> SpatialIndex<T> for UniformGrid3d<T> {
             locs: Vec::new(),
             spheres: Vec::new(),
             filters: Vec::new(),
+            inert: InertCount::default(),
             large: Vec::new(),
             extent: Aabb::EMPTY,
         };

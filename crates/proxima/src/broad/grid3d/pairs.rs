@@ -7,6 +7,10 @@
 //! order, each of those is one contiguous run of spheres (the molecular-dynamics
 //! "cell list" trick), so an object is compared with five runs of about three
 //! spheres, four at a time, instead of with thirteen cells of about one.
+//!
+//! Inert objects (group or mask zero) are dropped from the gathered rows and
+//! large inert objects skipped [sources: index-queries], so they cost the scan
+//! one filter read each; the filters of the pairs found are checked per batch.
 
 use super::cells::INLINE;
 use super::UniformGrid3d;
@@ -110,6 +114,27 @@ impl Row {
         Sphere::new(glam::vec3(self.x[k], self.y[k], self.z[k]), self.r[k])
     }
 
+    /// Removes the inert objects ([`Filter::is_inert`](crate::broad::Filter::is_inert))
+    /// from the row's slots and cells, before their spheres are gathered: they
+    /// interact with nothing, so the scan never meets them. Branch-free, one
+    /// filter read per object of the row.
+    fn drop_inert<T>(&mut self, g: &UniformGrid3d<T>) {
+        let mut k = 0;
+        for x in 0..self.off.len() - 1 {
+            let (s, e) = (self.off[x] as usize, self.off[x + 1] as usize);
+            self.off[x] = k as u32;
+            for p in s..e {
+                let slot = self.slot[p];
+                self.slot[k] = slot;
+                self.cx[k] = x as u32;
+                k += !g.filters[slot as usize].is_inert() as usize;
+            }
+        }
+        *self.off.last_mut().expect("a row has cells") = k as u32;
+        self.slot.truncate(k);
+        self.cx.truncate(k);
+    }
+
     /// The candidates among positions `j .. j + 4` for sphere `a`, as bits
     /// (lanes past the row's end may be set: the caller masks them).
     #[inline(always)]
@@ -193,6 +218,9 @@ impl Ring {
             row.off.push(p as u32);
             row.slot.truncate(total);
             row.cx.truncate(total);
+            if g.inert.any() {
+                row.drop_inert(g);
+            }
             // ... then a tight loop of independent reads of their spheres, so
             // that many cache misses are in flight at once.
             let n = row.slot.len() + PAD;
@@ -351,9 +379,12 @@ impl<T> UniformGrid3d<T> {
         i: usize,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
+        let fa = self.filters[self.large[i] as usize];
+        if fa.is_inert() {
+            return ControlFlow::Continue(());
+        }
         let (ha, va) = self.resolve(self.large[i]);
         let sa = &self.spheres[self.large[i] as usize];
-        let fa = self.filters[self.large[i] as usize];
         for &b in &self.large[i + 1..] {
             if fa.interacts(self.filters[b as usize])
                 && overlap::sphere_sphere(sa, &self.spheres[b as usize])

@@ -79,6 +79,10 @@ impl<T> UniformGrid3d<T> {
         if spilled != self.store.spill.len() {
             return fail(format!("{spilled} cells need a spill table entry"));
         }
-        Ok(())
+        (self.inert).check(
+            self.items
+                .iter()
+                .map(|(h, _)| self.filters[h.index() as usize]),
+        )
     }
 }

@@ -104,6 +104,7 @@ impl<T> LooseKdTree<T> {
         let p = (start + len) as usize;
         self.store.set(p, sphere);
         self.store.entry[p] = Some((handle, filter, value));
+        self.inert.add(filter);
         self.nodes[node].len = len + 1;
         self.widen_filters(node, filter);
         *self
@@ -135,6 +136,7 @@ impl<T> LooseKdTree<T> {
         let (p, last) = ((n.start + loc.pos) as usize, (n.start + n.len) as usize);
         let sphere = self.store.sphere[p];
         let (handle, filter, value) = self.store.entry[p].take().expect("live position");
+        self.inert.sub(filter);
         if p != last {
             self.store.set(p, self.store.sphere[last]);
             let moved = self.store.entry[last].take();

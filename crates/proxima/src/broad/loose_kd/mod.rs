@@ -30,6 +30,7 @@ pub use visit::KdNodeView;
 
 use crate::arena::{Arena, Pool};
 
+use crate::broad::filter::InertCount;
 use crate::broad::walk::{walk_methods, Walk};
 use crate::broad::{Filter, IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
@@ -194,6 +195,9 @@ pub struct LooseKdTree<T> {
     store: Store<T>,
     /// Buffers of the pair search, reused between calls.
     scratch: pairs::PairScratch,
+    /// Inert objects stored: while there are some, the pair search leaves
+    /// them out (reading each object's filter as it collects spheres).
+    inert: InertCount,
     root: u32,
     world: Aabb,
     r_max: f32,
@@ -234,6 +238,7 @@ impl<T> LooseKdTree<T> {
             nodes: Pool::default(),
             store: Store::default(),
             scratch: Default::default(),
+            inert: InertCount::default(),
             root: NIL,
             world,
             r_max,
@@ -349,7 +354,11 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
     fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
         let loc = *self.items.get(handle)?;
         let p = self.position(loc);
-        self.store.entry[p].as_mut().expect("live position").1 = filter;
+        let old = std::mem::replace(
+            &mut self.store.entry[p].as_mut().expect("live position").1,
+            filter,
+        );
+        self.inert.change(old, filter);
         self.widen_filters(loc.node, filter);
         Ok(())
     }
@@ -364,6 +373,7 @@ impl<T: Send + Sync> SpatialIndex<T> for LooseKdTree<T> {
         self.nodes.clear();
         self.store = Store::default();
         self.scratch = Default::default();
+        self.inert = InertCount::default();
         self.root = NIL;
         self.span = self.world;
         self.eps = node::slack(&self.span);

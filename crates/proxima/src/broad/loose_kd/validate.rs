@@ -42,8 +42,8 @@ impl<T> LooseKdTree<T> {
             return fail("span does not cover the world or eps is stale".into());
         }
         if self.root == NIL {
-            if !self.nodes.is_empty() || !self.items.is_empty() {
-                return fail("no root but live nodes or items".into());
+            if !self.nodes.is_empty() || !self.items.is_empty() || self.inert.any() {
+                return fail("no root but live nodes, items or inert count".into());
             }
             return Ok(());
         }
@@ -181,6 +181,7 @@ impl<T> LooseKdTree<T> {
                 return fail(format!("dead position {p} not empty"));
             }
         }
-        Ok(())
+        // Every other position is empty (checked above): these are the live ones.
+        (self.inert).check(self.store.entry.iter().flatten().map(|(_, f, _)| *f))
     }
 }

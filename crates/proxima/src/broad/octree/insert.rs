@@ -28,6 +28,7 @@ impl<T> LinearOctree<T> {
             filter,
             value,
         })?;
+        self.inert.add(filter);
         let start = self.locate(key);
         let leaf = self.descend_to_leaf(start, key);
         self.push_item(
@@ -50,6 +51,7 @@ impl<T> LinearOctree<T> {
         let (leaf, slot) = (o.leaf, o.slot);
         let item = self.take_item(leaf, slot);
         let obj = self.objects.remove(h)?;
+        self.inert.sub(obj.filter);
         self.shrink_chain(leaf, NONE, item.ext);
         Ok(obj.value)
     }

@@ -25,6 +25,7 @@ pub use stats::OctreeStats;
 
 use crate::arena::{Arena, Pool};
 
+use crate::broad::filter::InertCount;
 use crate::broad::walk::{walk_methods, Walk};
 use crate::broad::{Filter, IndexKind, RayHit, SceneHint, Selection, SpatialIndex};
 use crate::geom::{Aabb, Ray, Sphere};
@@ -160,6 +161,9 @@ pub struct LinearOctree<T> {
     /// Live nodes per depth (bounds the depth search of long jumps).
     per_depth: [u32; MAX_DEPTH as usize + 1],
     counters: stats::Counters,
+    /// Inert objects stored: while there are some, the pair search leaves
+    /// them out (see `pairs.rs`).
+    inert: InertCount,
 }
 
 impl<T> LinearOctree<T> {
@@ -205,6 +209,7 @@ impl<T> LinearOctree<T> {
             spare: Vec::new(),
             per_depth: [0; MAX_DEPTH as usize + 1],
             counters: Default::default(),
+            inert: InertCount::default(),
         };
         t.root = t.new_node(LocationCode::ROOT, node::NONE);
         Ok(t)
@@ -284,8 +289,9 @@ impl<T: Send + Sync> SpatialIndex<T> for LinearOctree<T> {
 
     fn set_filter(&mut self, handle: Handle, filter: Filter) -> Result<()> {
         let o = self.objects.get_mut(handle)?;
-        o.filter = filter;
+        let old = std::mem::replace(&mut o.filter, filter);
         let leaf = o.leaf;
+        self.inert.change(old, filter);
         self.widen_filters(leaf, filter);
         Ok(())
     }

@@ -288,6 +288,7 @@ impl<T> LinearOctree<T> {
         self.spare = Vec::new();
         self.per_depth = [0; MAX_DEPTH as usize + 1];
         self.counters = Default::default();
+        self.inert = Default::default();
         self.root = self.new_node(LocationCode::ROOT, NONE);
     }
 }

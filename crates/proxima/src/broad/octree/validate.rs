@@ -33,7 +33,8 @@ impl<T> LinearOctree<T> {
     /// `max_depth` holds more than `max_per_leaf`; each object is in the leaf of its
     /// (clamped) centre, with its slot, sphere, key and extent recorded
     /// consistently; `max_extent` is never below any extent in the subtree; every
-    /// sphere lies inside its leaf's loose box; per-depth counts; spare lists empty.
+    /// sphere lies inside its leaf's loose box; per-depth counts; spare lists empty;
+    /// the inert count.
     /// O(n + nodes).
     pub(super) fn validate_tree(&self) -> Result<()> {
         self.objects.validate()?;
@@ -83,7 +84,7 @@ impl<T> LinearOctree<T> {
         if self.spare.iter().any(|v| !v.is_empty()) {
             return fail("a spare item list is not empty".into());
         }
-        Ok(())
+        self.inert.check(self.objects.iter().map(|(_, o)| o.filter))
     }
 
     fn check_node(&self, i: u32, c: [u32; 3], d: u32, per_depth: &mut [u32]) -> Result<Sub> {

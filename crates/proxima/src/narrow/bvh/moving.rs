@@ -86,6 +86,11 @@ pub(crate) trait Descent<BV: BoundingVolume> {
     /// query's code holds only the sources it may use.
     fn moved(rotation: RotationUpdate) -> Moved;
 
+    /// Whether transformed volumes are the tight ones
+    /// ([`BoundingVolume::transformed_tight`]): worth it where a better bound
+    /// prunes more than it costs (distance), not for collision.
+    const TIGHT: bool = false;
+
     /// Descends with the moving tree's volumes from `src`; the moving mesh's
     /// posed vertex `v` is `corner(v)` (`pose.transform_point3` of it, the same
     /// `f32` values whichever the source). The corner is a type parameter, not
@@ -160,6 +165,7 @@ impl<BV: BoundingVolume> MovingVolumes<BV> {
             slack,
             cache,
             updates: 0,
+            tight: D::TIGHT,
         };
         if let Moved::Exact { below } = moved_by {
             let mut src = ExactLeaves {

@@ -64,6 +64,19 @@ pub(crate) struct Lazy<'a, BV> {
     pub slack: f32,
     pub cache: &'a mut super::tri_cache::QueryCache<BV>,
     pub updates: u64,
+    /// Take [`BoundingVolume::transformed_tight`] (the distance descent) rather
+    /// than [`BoundingVolume::transformed`] (collision).
+    pub tight: bool,
+}
+
+/// The conservative moved volume of `bv`: the tight bound or the cheap one.
+#[inline(always)]
+fn moved_bound<BV: BoundingVolume>(bv: &BV, pose: &glam::Affine3A, tight: bool) -> BV {
+    if tight {
+        bv.transformed_tight(pose)
+    } else {
+        bv.transformed(pose)
+    }
 }
 
 impl<BV: BoundingVolume> Lazy<'_, BV> {
@@ -72,9 +85,9 @@ impl<BV: BoundingVolume> Lazy<'_, BV> {
         if !self.cache.is_set(i) {
             self.updates += 1;
         }
-        let (nodes, pose, slack) = (self.nodes, &self.pose, self.slack);
+        let (nodes, pose, slack, tight) = (self.nodes, &self.pose, self.slack, self.tight);
         self.cache
-            .get(i, || nodes[i].bv.transformed(pose).inflated(slack))
+            .get(i, || moved_bound(&nodes[i].bv, pose, tight).inflated(slack))
     }
 }
 
@@ -143,7 +156,7 @@ impl<BV: BoundingVolume> ExactLeaves<'_, BV> {
             return bv.inflated(self.lazy.slack);
         }
         if self.sizes[i] > self.below {
-            return n.bv.transformed(&self.lazy.pose).inflated(self.lazy.slack);
+            return moved_bound(&n.bv, &self.lazy.pose, self.lazy.tight).inflated(self.lazy.slack);
         }
         // A small subtree: the merge of the children's exact volumes (each
         // cached, as the descent will likely need them).

@@ -6,8 +6,8 @@
 
 use proxima::broad::{
     AnyIndex, BruteForce, Grid2dConfig, Grid3dConfig, HashGrid, HashGridConfig, IndexKind,
-    LinearOctree, LooseKdConfig, LooseKdTree, SceneHint, SpatialIndex, SpatialIndexExt,
-    UniformGrid2d, UniformGrid3d,
+    LinearOctree, LooseKdConfig, LooseKdTree, Metric, Nearest, SceneHint, SpatialIndex,
+    SpatialIndexExt, UniformGrid2d, UniformGrid3d,
 };
 use proxima::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};
 use proxima::glam::{vec3, Mat4, Vec3};
@@ -184,6 +184,48 @@ fn huge_coordinates_and_radii<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
     );
 }
 per_index!(huge_coordinates_and_radii);
+
+// ---- k nearest where every distance overflows to infinity -------------------------
+
+/// Regression (proptest, `tests/ops`): a query near `f32::MAX` makes every
+/// distance infinite; with no distance limit those objects still count, so the
+/// grids' growing box must not take an infinite face bound for "no more
+/// cells" (the 2D grid answered nothing where brute force found an object).
+fn nearest_with_overflowing_distances<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
+    let mut i = make();
+    let mut brute = BruteForce::new();
+    for (id, c) in [
+        vec3(10.0, 20.0, 30.0),
+        vec3(90.0, 5.0, 1.0),
+        vec3(50.0, 50.0, 99.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let s = Sphere::new(c, 0.5);
+        let (a, b) = (
+            i.insert(s, id as u32).unwrap(),
+            brute.insert(s, id as u32).unwrap(),
+        );
+        assert_eq!(a, b, "handles are assigned alike");
+    }
+    for point in [
+        vec3(-2.3806633e23, -11.5, 3.4028235e38),
+        vec3(3.4e38, -3.4e38, 0.0),
+    ] {
+        for metric in [Metric::Surface, Metric::Center] {
+            for k in [1, 2, 5] {
+                let q = Nearest::new(point, k).metric(metric);
+                let (mut got, mut want) = (Vec::new(), Vec::new());
+                i.nearest_into(&q, None, &mut got).unwrap();
+                brute.nearest_into(&q, None, &mut want).unwrap();
+                assert_eq!(got, want, "{point} {metric:?} k={k}");
+                assert_eq!(got.len(), k.min(3), "every object counts at distance inf");
+            }
+        }
+    }
+}
+per_index!(nearest_with_overflowing_distances);
 
 // ---- leaving the world and coming back; remove all and re-insert -----------------
 

@@ -83,6 +83,9 @@ impl Knn for Ours {
     }
 }
 
+/// Builds one structure over the set (`true`: the set is points).
+type Build = Box<dyn Fn(&[Sphere], &Scene, bool) -> Box<dyn Knn>>;
+
 /// One structure of the table: name, build mode (`-` for ours), peer or not,
 /// which sets it takes and how it is built.
 struct Entry {
@@ -90,7 +93,7 @@ struct Entry {
     mode: &'static str,
     peer: bool,
     points_only: bool,
-    build: Box<dyn Fn(&[Sphere], &Scene, bool) -> Box<dyn Knn>>,
+    build: Build,
 }
 
 /// The reference every answer is checked against (always built).

@@ -161,7 +161,7 @@ impl Sweeper for ParryCast {
                 options(),
             )
             .ok()??;
-            return Some((hit.subshape1.into(), hit.time_of_impact));
+            return Some((hit.subshape1, hit.time_of_impact));
         }
         self.with_leaf_cast(|cast| {
             self.tree().find_best(

@@ -185,55 +185,6 @@ fn huge_coordinates_and_radii<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
 }
 per_index!(huge_coordinates_and_radii);
 
-// ---- k nearest where every distance overflows to infinity -------------------------
-
-/// Regression (proptest, `tests/ops`): a query near `f32::MAX` makes every
-/// distance infinite; with no distance limit those objects still count, so the
-/// grids' growing box must not take an infinite face bound for "no more
-/// cells" (the 2D grid answered nothing where brute force found an object).
-fn nearest_with_overflowing_distances<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
-    let mut i = make();
-    let mut brute = BruteForce::new();
-    // Each index tags its own handles: answers are compared as (id, distance).
-    let (mut hi, mut hb) = (Vec::new(), Vec::new());
-    for (id, c) in [
-        vec3(10.0, 20.0, 30.0),
-        vec3(90.0, 5.0, 1.0),
-        vec3(50.0, 50.0, 99.0),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let s = Sphere::new(c, 0.5);
-        hi.push(i.insert(s, id as u32).unwrap());
-        hb.push(brute.insert(s, id as u32).unwrap());
-    }
-    let as_ids = |v: &[proxima::broad::Neighbor], hs: &[Handle]| -> Vec<(usize, f32)> {
-        v.iter()
-            .map(|n| (hs.iter().position(|&h| h == n.handle).unwrap(), n.distance))
-            .collect()
-    };
-    for point in [
-        vec3(-2.3806633e23, -11.5, 3.4028235e38),
-        vec3(3.4e38, -3.4e38, 0.0),
-    ] {
-        for metric in [Metric::Surface, Metric::Center] {
-            for k in [1, 2, 5] {
-                let q = Nearest::new(point, k).metric(metric);
-                let (mut got, mut want) = (Vec::new(), Vec::new());
-                i.nearest_into(&q, None, &mut got).unwrap();
-                brute.nearest_into(&q, None, &mut want).unwrap();
-                let got = as_ids(&got, &hi);
-                // Ties (every distance is inf) go by handle, and both
-                // assign handles in insertion order: the same ids in order.
-                assert_eq!(got, as_ids(&want, &hb), "{point} {metric:?} k={k}");
-                assert_eq!(got.len(), k.min(3), "every object counts at distance inf");
-            }
-        }
-    }
-}
-per_index!(nearest_with_overflowing_distances);
-
 // ---- leaving the world and coming back; remove all and re-insert -----------------
 
 fn leave_world_and_return<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {

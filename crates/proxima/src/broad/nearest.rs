@@ -352,45 +352,30 @@ pub(crate) fn grow_box(
     if visit(best, &start, &KeyBox::EMPTY).is_break() {
         return;
     }
-    // `None`: that face has reached the edge of `cells`. A face's bound may
-    // itself be infinite (a query near `f32::MAX` overflows every distance),
-    // and objects at an infinite distance still count when no limit is set,
-    // so infinity cannot mark an exhausted face (proptest regression: a 2D
-    // grid answered nothing at (-2.4e23, -11.5, 3.4e38) where brute force found
-    // an object at distance inf). NaN is taken as infinite: still visited.
     let bound_of = |seen: &KeyBox, a: usize, upper: bool| {
-        let d = if upper && seen.hi[a] < cells.hi[a] {
+        if upper && seen.hi[a] < cells.hi[a] {
             face(a, true, seen.hi[a] + 1)
         } else if !upper && seen.lo[a] > cells.lo[a] {
             face(a, false, seen.lo[a] - 1)
         } else {
-            return None;
-        };
-        Some(if d.is_nan() { f32::INFINITY } else { d })
+            f32::INFINITY
+        }
     };
-    let mut bounds = [[None; 2]; 3];
+    let mut bounds = [[f32::INFINITY; 2]; 3];
     for (a, b) in bounds.iter_mut().enumerate().take(axes) {
         *b = [bound_of(&seen, a, false), bound_of(&seen, a, true)];
     }
     loop {
-        let mut next: Option<(f32, usize, usize)> = None;
+        let mut next = (f32::INFINITY, 0, 0);
         for (a, b) in bounds.iter().enumerate().take(axes) {
-            for (side, d) in b.iter().enumerate() {
-                if let Some(d) = *d {
-                    let nearer = match next {
-                        None => true,
-                        Some(n) => d < n.0,
-                    };
-                    if nearer {
-                        next = Some((d, a, side));
-                    }
+            for (side, &d) in b.iter().enumerate() {
+                if d < next.0 {
+                    next = (d, a, side);
                 }
             }
         }
-        let Some((d, a, side)) = next else {
-            return;
-        };
-        if d > best.bound() {
+        let (d, a, side) = next;
+        if d == f32::INFINITY || d > best.bound() {
             return;
         }
         let mut slab = seen;

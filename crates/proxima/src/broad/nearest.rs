@@ -313,6 +313,20 @@ fn next_up(x: f32) -> f32 {
     }
 }
 
+/// Whether some distance from `point` to a sphere inside `extent` may round
+/// to infinity (a point near `f32::MAX`). The grids' [`grow_box`] takes an
+/// infinite face bound for "no more cells", so such queries go to
+/// [`expanding`] instead, which ends in one scan of everything (ops proptest:
+/// a 2D grid answered nothing where brute force found an object at distance
+/// inf).
+pub(crate) fn may_overflow(point: Vec3, extent: &crate::geom::Aabb) -> bool {
+    let p = point.as_dvec3();
+    let far = (p - extent.min.as_dvec3())
+        .abs()
+        .max((p - extent.max.as_dvec3()).abs());
+    !(far.length() < f32::MAX as f64 * 0.5)
+}
+
 /// The grids' k-nearest search [sources: index-queries]: a box of cells
 /// growing one face at a time around the query's cell, nearest face first.
 ///

@@ -373,6 +373,9 @@ macro_rules! cell_grid_index {
                 filter: Option<$crate::broad::Filter>,
                 out: &mut Vec<$crate::broad::Neighbor>,
             ) {
+                if $crate::broad::nearest::may_overflow(query.point, &self.grid.knn_extent()) {
+                    return $crate::broad::nearest::expanding(self, query, filter, out);
+                }
                 self.grid.nearest(query, filter, out)
             }
         }

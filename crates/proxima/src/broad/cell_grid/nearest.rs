@@ -33,6 +33,11 @@ use std::ops::ControlFlow;
 const LOOKUPS_PER_CELL: u64 = 4;
 
 impl<T, S: Store> CellGrid<T, S> {
+    /// The box of every gridded sphere (what [`may_overflow`](crate::broad::nearest::may_overflow) checks).
+    pub(crate) fn knn_extent(&self) -> crate::geom::Aabb {
+        self.reach.extent
+    }
+
     /// The `k` nearest among the objects `filter` admits into `out`, nearest
     /// first, ties by handle (see the module docs). Cost: the oversized list,
     /// plus the cells of the smallest box around the point's cell that holds

@@ -353,9 +353,9 @@ impl<T> Walk<T> for UniformGrid3d<T> {
         query: &Q,
         mut f: impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        if let Some(ray) = query.as_ray() {
+        if let Some(ray) = query.as_ray().filter(|r| self.walkable(*r)) {
             self.visit_cast(ray, &mut f)?;
-        } else if let Some(sweep) = query.as_sweep() {
+        } else if let Some(sweep) = query.as_sweep().filter(|s| self.walkable(*s)) {
             self.visit_cast(sweep, &mut f)?;
         } else if let Some(b) = query.bounds() {
             let (lo, hi) = self.geom.range(&b);
@@ -407,6 +407,9 @@ impl<T> Walk<T> for UniformGrid3d<T> {
         filter: Option<Filter>,
         out: &mut Vec<crate::broad::Neighbor>,
     ) {
+        if crate::broad::nearest::may_overflow(query.point, &self.extent) {
+            return crate::broad::nearest::expanding(self, query, filter, out);
+        }
         self.nearest_impl(query, filter, out)
     }
 

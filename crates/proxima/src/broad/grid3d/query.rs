@@ -202,6 +202,26 @@ impl<T> UniformGrid3d<T> {
         Some((path, self.extent.grown(path.reach(m) - self.geom.limit)))
     }
 
+    /// Whether [`UniformGrid3d::visit_cast`] can walk `cast`: its reach and
+    /// the grown bounds are finite. A sweep of a radius near `f32::MAX` makes
+    /// them infinite and the exact clipping then meets `inf - inf` (NaN), on
+    /// which it would not terminate (ops proptest); such casts take the
+    /// exact cell-range visit instead.
+    pub(super) fn walkable<C: Cast>(&self, cast: &C) -> bool {
+        match self.path_of(cast) {
+            None => true,
+            Some((path, ext)) => {
+                path.ray.origin.is_finite()
+                    && path.ray.dir.is_finite()
+                    && path
+                        .reach(ext.min.abs().max(ext.max.abs()).max_element())
+                        .is_finite()
+                    && ext.min.is_finite()
+                    && ext.max.is_finite()
+            }
+        }
+    }
+
     /// Reports the gridded objects a ray or a sphere sweep touches.
     ///
     /// The cast's path (a sweep's segment, [`Cast::path`]) is clipped to the

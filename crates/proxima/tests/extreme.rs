@@ -9,7 +9,7 @@ use proxima::broad::{
     LinearOctree, LooseKdConfig, LooseKdTree, Metric, Nearest, SceneHint, SpatialIndex,
     SpatialIndexExt, UniformGrid2d, UniformGrid3d,
 };
-use proxima::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere};
+use proxima::geom::{overlap, Aabb, Frustum, Ray, Segment, Sphere, SphereSweep};
 use proxima::glam::{vec3, Mat4, Vec3};
 use proxima::{Error, Handle};
 use proxima_harness::oracle::make_index;
@@ -184,6 +184,118 @@ fn huge_coordinates_and_radii<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
     );
 }
 per_index!(huge_coordinates_and_radii);
+
+// ---- k nearest where every distance overflows to infinity -------------------------
+
+/// Regression (proptest, `tests/ops`): a query near `f32::MAX` makes every
+/// distance infinite; with no distance limit those objects still count (the
+/// 2D grid's growing box took an infinite face bound for "no more cells" and
+/// answered nothing where brute force found an object). The grids now send
+/// such queries to the expanding search (`nearest::may_overflow`).
+fn nearest_with_overflowing_distances<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
+    let mut i = make();
+    let mut brute = BruteForce::new();
+    // Each index tags its own handles: answers are compared as (id, distance).
+    let (mut hi, mut hb) = (Vec::new(), Vec::new());
+    for (id, c) in [
+        vec3(10.0, 20.0, 30.0),
+        vec3(90.0, 5.0, 1.0),
+        vec3(50.0, 50.0, 99.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let s = Sphere::new(c, 0.5);
+        hi.push(i.insert(s, id as u32).unwrap());
+        hb.push(brute.insert(s, id as u32).unwrap());
+    }
+    let as_ids = |v: &[proxima::broad::Neighbor], hs: &[Handle]| -> Vec<(usize, f32)> {
+        v.iter()
+            .map(|n| (hs.iter().position(|&h| h == n.handle).unwrap(), n.distance))
+            .collect()
+    };
+    for point in [
+        vec3(-2.3806633e23, -11.5, 3.4028235e38),
+        vec3(3.4e38, -3.4e38, 0.0),
+    ] {
+        for metric in [Metric::Surface, Metric::Center] {
+            for k in [1, 2, 5] {
+                let q = Nearest::new(point, k).metric(metric);
+                let (mut got, mut want) = (Vec::new(), Vec::new());
+                i.nearest_into(&q, None, &mut got).unwrap();
+                brute.nearest_into(&q, None, &mut want).unwrap();
+                let got = as_ids(&got, &hi);
+                // Ties (every distance is inf) go by handle, and both
+                // assign handles in insertion order: the same ids in order.
+                assert_eq!(got, as_ids(&want, &hb), "{point} {metric:?} k={k}");
+                assert_eq!(got.len(), k.min(3), "every object counts at distance inf");
+            }
+        }
+    }
+}
+per_index!(nearest_with_overflowing_distances);
+
+// ---- sphere sweeps at extreme coordinates and radii --------------------------------
+
+/// Regressions (proptest, `tests/ops`): the hash grid's widened-segment walk
+/// missed a hit of a sweep from x = 3.4e38 (its padded coordinates overflowed
+/// to infinity), and the 3D grid's first-hit walk never ended on a sweep
+/// whose radius made its reach infinite (`inf - inf` in the clipping). Every
+/// sweep's hits and first hit are compared with brute force by id.
+fn sweeps_at_extreme_coordinates<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
+    let m = f32::MAX;
+    let mut i = make();
+    let mut brute = BruteForce::new();
+    let (mut hi, mut hb) = (Vec::new(), Vec::new());
+    let spheres = [
+        Sphere::new(vec3(1.0, 2.0, 3.0), 0.5),
+        Sphere::new(vec3(-9.0, -11.75, -5.5), 4.0),
+        Sphere::new(vec3(60.0, 0.0, -3.0), 0.0),
+        Sphere::new(vec3(50.0, 50.0, 50.0), 10.0),
+        Sphere::new(vec3(1e30, -1e30, 0.0), 1e29),
+        Sphere::new(vec3(0.0, 0.0, 0.0), 2.0),
+        Sphere::new(vec3(-3e38, 0.0, 0.0), 1e30),
+    ];
+    for (id, s) in spheres.into_iter().enumerate() {
+        hi.push(i.insert(s, id as u32).unwrap());
+        hb.push(brute.insert(s, id as u32).unwrap());
+    }
+    let id_of = |h: Handle, hs: &[Handle]| hs.iter().position(|&x| x == h).unwrap();
+    let hits = |v: Vec<proxima::broad::SweepHit>, hs: &[Handle]| -> BTreeSet<(usize, u32)> {
+        v.iter()
+            .map(|h| (id_of(h.handle, hs), h.t.to_bits()))
+            .collect()
+    };
+    let sweeps = [
+        // The hash grid's missed hit (shrunk by proptest).
+        SphereSweep::new(
+            vec3(3.4028235e38, 1e-30, -3.25),
+            vec3(-2.0991098e36, -11.75, -5.5),
+            179.0,
+        ),
+        SphereSweep::new(vec3(-m, 50.0, 50.0), vec3(m, 50.0, 50.0), 1.0),
+        SphereSweep::new(vec3(m, m, m), vec3(0.0, 0.0, 0.0), 3.0),
+        SphereSweep::new(vec3(50.0, 50.0, 50.0), vec3(0.0, 0.0, 0.0), 3e38),
+        SphereSweep::new(vec3(-50.0, 0.0, 0.0), vec3(70.0, 0.0, -3.0), m),
+        SphereSweep::new(vec3(1e30, 1e30, 1e30), vec3(-1e30, -1e30, 0.0), 1e30),
+        SphereSweep::new(vec3(0.0, -m, 0.0), vec3(0.0, m, 0.0), 0.0),
+        SphereSweep::new(vec3(-1e38, 2.0, 3.0), vec3(1e38, 2.0, 3.0), 0.25),
+    ];
+    let mut total = 0;
+    for sw in &sweeps {
+        let want = hits(brute.sweep_hits(sw).unwrap(), &hb);
+        total += want.len();
+        assert_eq!(hits(i.sweep_hits(sw).unwrap(), &hi), want, "{sw:?}");
+        let first = |h: Option<proxima::broad::SweepHit>| h.map(|h| h.t.to_bits());
+        assert_eq!(
+            first(i.sweep_first(sw, None).unwrap()),
+            first(brute.sweep_first(sw, None).unwrap()),
+            "first {sw:?}"
+        );
+    }
+    assert!(total >= 10, "the sweeps must hit ({total})");
+}
+per_index!(sweeps_at_extreme_coordinates);
 
 // ---- leaving the world and coming back; remove all and re-insert -----------------
 
@@ -703,4 +815,70 @@ fn far_rays_agree<I: SpatialIndex<u32>>(mut i: I) -> usize {
         }
     }
     hits
+}
+
+/// Regression (proptest, `tests/ops`): a nearly vertical ray over the 2D grid
+/// from y = -8.7e-20, in a grid whose lines sit at -16 + 4k: `coord` rounded
+/// `y + 16` to 16 and started the walk in the cell above the origin's, whose
+/// strip the ray enters only at t = 5e5, so it found nothing where brute force
+/// hit two spheres at t = 0. Each grid, both directions, rays and first hits.
+#[test]
+fn grid_walk_start_cell_rounding() {
+    let w = Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0));
+    let spheres = [
+        Sphere::new(vec3(-12.0, -26.25, 13.75), 31.75),
+        Sphere::new(vec3(0.0, -7.25, -11.0), 31.625),
+        Sphere::new(vec3(0.0, 28.0, 8.25), 2.179795e32),
+        Sphere::new(vec3(0.0, -31.5, 0.0), 15.125),
+        Sphere::new(vec3(0.5, -0.5, 0.0), 0.75),
+        Sphere::new(vec3(-0.75, 0.5, -1.0), 0.75),
+    ];
+    let rays = [
+        Ray::with_max_t(
+            vec3(-6.36791e-32, -8.718356e-20, -2.9577731e-12),
+            vec3(0.0, 1.6723203e-25, -32.0),
+            164.0,
+        ),
+        Ray::with_max_t(
+            vec3(-6.36791e-32, 8.718356e-20, -2.9577731e-12),
+            vec3(0.0, -1.6723203e-25, -32.0),
+            164.0,
+        ),
+        Ray::new(vec3(-8.718356e-20, 0.25, 0.0), vec3(1e-25, 0.0, 1.0)),
+        Ray::new(vec3(8.718356e-20, 0.25, 0.0), vec3(-1e-25, 0.0, -1.0)),
+    ];
+    let check = |mut i: AnyIndex<u32>| {
+        let mut b = BruteForce::new();
+        for (k, s) in spheres.iter().enumerate() {
+            i.insert(*s, k as u32).unwrap();
+            b.insert(*s, k as u32).unwrap();
+        }
+        let mut hits = 0;
+        for ray in &rays {
+            let key = |j: &dyn SpatialIndex<u32>, v: Vec<proxima::broad::RayHit>| {
+                let mut v: Vec<_> = v
+                    .iter()
+                    .map(|h| (*j.get(h.handle).unwrap().1, h.t.to_bits()))
+                    .collect();
+                v.sort();
+                v
+            };
+            let want = key(&b, b.ray_hits(ray).unwrap());
+            hits += want.len();
+            assert_eq!(key(&i, i.ray_hits(ray).unwrap()), want, "{ray:?}");
+            let first = |h: Option<proxima::broad::RayHit>| h.map(|h| h.t.to_bits());
+            assert_eq!(
+                first(i.ray_first(ray, None).unwrap()),
+                first(b.ray_first(ray, None).unwrap()),
+                "{ray:?}"
+            );
+        }
+        assert!(hits >= 8, "the rays must hit ({hits})");
+    };
+    check(AnyIndex::Grid2d(UniformGrid2d::new(w, 2.0).unwrap()));
+    check(AnyIndex::Grid3d(UniformGrid3d::new(w, 2.0).unwrap()));
+    check(AnyIndex::HashGrid(HashGrid::new(2.0).unwrap()));
+    check(AnyIndex::HashGrid(
+        HashGrid::with_config(HashGridConfig { cell_size: 4.0 }).unwrap(),
+    ));
 }

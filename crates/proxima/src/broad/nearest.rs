@@ -324,7 +324,9 @@ pub(crate) fn may_overflow(point: Vec3, extent: &crate::geom::Aabb) -> bool {
     let far = (p - extent.min.as_dvec3())
         .abs()
         .max((p - extent.max.as_dvec3()).abs());
-    !(far.length() < f32::MAX as f64 * 0.5)
+    // NaN (an infinite coordinate) counts as overflowing too.
+    let len = far.length();
+    len.is_nan() || len >= f32::MAX as f64 * 0.5
 }
 
 /// The grids' k-nearest search [sources: index-queries]: a box of cells

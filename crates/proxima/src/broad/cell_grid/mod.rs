@@ -352,17 +352,18 @@ macro_rules! cell_grid_index {
                 self.grid.first_hit(ray, filter)
             }
             /// The cell walk along the sweep's segment, widened by its radius;
-            /// a scan of the cells of its box when they are few.
+            /// a scan of the cells of its box when they are few or the sweep's
+            /// coordinates are near `f32::MAX` (`sweep_walks`).
             #[inline]
             fn first_sweep_hit(
                 &self,
                 sweep: &$crate::geom::SphereSweep,
                 filter: Option<$crate::broad::Filter>,
             ) -> Option<$crate::broad::RayHit> {
-                if self.grid.sweep_is_short(sweep) {
-                    $crate::broad::walk::scan_first(self, sweep, filter)
-                } else {
+                if self.grid.sweep_walks(sweep) {
                     self.grid.first_hit(sweep, filter)
+                } else {
+                    $crate::broad::walk::scan_first(self, sweep, filter)
                 }
             }
             /// The growing box of cells (`cell_grid/nearest.rs`).

@@ -63,7 +63,7 @@ impl<T, S: Store> CellGrid<T, S> {
     ) -> ControlFlow<()> {
         if let Some(ray) = q.as_ray() {
             self.visit_cast(ray, &mut f)?;
-        } else if let Some(sweep) = q.as_sweep().filter(|s| !self.sweep_is_short(s)) {
+        } else if let Some(sweep) = q.as_sweep().filter(|s| self.sweep_walks(s)) {
             self.visit_cast(sweep, &mut f)?;
         } else {
             let lattice = self.store.lattice();
@@ -92,6 +92,26 @@ impl<T, S: Store> CellGrid<T, S> {
     pub fn sweep_is_short(&self, sweep: &SphereSweep) -> bool {
         let lattice = self.store.lattice();
         lattice.aabb_box(&sweep.aabb(), S::AXES).volume() <= FLAT_CELLS
+    }
+
+    /// True if `sweep` takes the cell walk along its segment (`ray.rs`):
+    /// it is not [short](Self::sweep_is_short), and its coordinates, length
+    /// and radius are far enough below `f32::MAX` that the walk's padded
+    /// coordinates stay finite (ops proptest: a sweep from x = 3.4e38 to
+    /// -2.1e36 padded them to infinity and missed a hit). Other sweeps visit
+    /// the cells of their bounds, exact at any magnitude.
+    #[inline]
+    pub fn sweep_walks(&self, sweep: &SphereSweep) -> bool {
+        // 2^-4 of f32::MAX leaves room for the walk's sums of coordinates,
+        // lengths and pads.
+        const SAFE: f32 = f32::MAX / 16.0;
+        let m = sweep
+            .from
+            .abs()
+            .max(sweep.to.abs())
+            .max((sweep.to - sweep.from).abs())
+            .max_element();
+        m + sweep.radius < SAFE && !self.sweep_is_short(sweep)
     }
 
     /// True if an object with lowest key `lo` is reported from `key` by a query

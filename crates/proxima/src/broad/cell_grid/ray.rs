@@ -165,14 +165,40 @@ impl<T, S: Store> CellGrid<T, S> {
             (v - pad, v + pad)
         };
         let (o0, o1) = if r > 0.0 { at(a, 0.0) } else { (o[a], o[a]) };
+        // The strip holding the path at t = 0. `coord` rounds `v - origin`
+        // (ops proptest: y = -8.7e-20 in a grid from -16 rounded to 16, the
+        // cell above the origin's, whose strip the ray entered only at
+        // t = 5e5): step back while the strip starts after t = 0, at most
+        // twice, then take the first strip (conservative).
+        let early = |s: i32| {
+            let inner = if forward {
+                s > lim.lo[a]
+            } else {
+                s < lim.hi[a]
+            };
+            inner && enter_t(s) > 0.0
+        };
+        let back = |mut s: i32| {
+            for _ in 0..2 {
+                if !early(s) {
+                    return s;
+                }
+                s = if forward { s - 1 } else { s + 1 };
+            }
+            match (early(s), forward) {
+                (false, _) => s,
+                (true, true) => lim.lo[a],
+                (true, false) => lim.hi[a],
+            }
+        };
         let start = if forward {
-            let s = lat.coord(o0, a);
+            let s = back(lat.coord(o0, a));
             if s > occ.hi[a] {
                 return ControlFlow::Continue(());
             }
             s.max(occ.lo[a])
         } else {
-            let s = lat.coord(o1, a);
+            let s = back(lat.coord(o1, a));
             if s < occ.lo[a] {
                 return ControlFlow::Continue(());
             }

@@ -388,6 +388,10 @@ impl<T> Walk<T> for UniformGrid3d<T> {
         ray: &crate::geom::Ray,
         filter: Option<Filter>,
     ) -> Option<crate::broad::RayHit> {
+        // A cast the dense walk cannot clip (see `walkable`): the generic scan.
+        if !self.walkable(ray) {
+            return crate::broad::walk::scan_first(self, ray, filter);
+        }
         self.first_cast(ray, filter)
     }
 
@@ -397,6 +401,10 @@ impl<T> Walk<T> for UniformGrid3d<T> {
         sweep: &crate::geom::SphereSweep,
         filter: Option<Filter>,
     ) -> Option<crate::broad::RayHit> {
+        // A cast the dense walk cannot clip (see `walkable`): the generic scan.
+        if !self.walkable(sweep) {
+            return crate::broad::walk::scan_first(self, sweep, filter);
+        }
         self.first_cast(sweep, filter)
     }
 

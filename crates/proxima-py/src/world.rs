@@ -746,7 +746,8 @@ fn csr_tuple(py: Python<'_>, out: Csr) -> PyResult<Bound<'_, PyTuple>> {
 ///   b; 0 for a ball), ascending within each pair; one per pair with
 ///   `first=True`;
 /// - `counters`: dict of ints — "broad_pairs" (candidate pairs from the
-///   broad phase), "filtered" (dropped by filters or ignored), "narrow_pairs"
+///   broad phase), "filtered" (dropped as ignored, or by filters the index
+///   did not already prune), "narrow_pairs"
 ///   (tested), "coherent_pairs" (reused unchanged), "cut_starts" (tests
 ///   started from the last traversal cut), "nv", "np", "nu" (volume tests,
 ///   primitive tests, volume updates).

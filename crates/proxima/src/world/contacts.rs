@@ -28,8 +28,10 @@ pub struct WorldCounters {
     /// reported them to this query (with coherence, only pairs involving a
     /// changed object may be enumerated; see `coherent_pairs`).
     pub broad_pairs: u64,
-    /// Candidate pairs dropped before the narrow phase: their filters do not
-    /// interact, or the pair is ignored.
+    /// Candidate pairs dropped before the narrow phase: the pair is ignored, or
+    /// its filters do not interact (every index prunes such pairs inside its
+    /// pair search, so they rarely reach the world and are not counted in
+    /// `broad_pairs` either).
     pub filtered: u64,
     /// Pairs the narrow phase tested.
     pub narrow_pairs: u64,

@@ -290,6 +290,7 @@ fn shape_is_independent_of_history() {
 fn depth_cap_holds_100k_points_on_one_point() {
     let mut t = LooseKdTree::with_config(LooseKdConfig {
         density: 0.5,
+        max_depth: LooseKdConfig::DEFAULT_MAX_DEPTH,
         ..LooseKdConfig::new(cube(100.0), 2.0)
     })
     .unwrap();
@@ -681,4 +682,87 @@ fn chunk_bounds_prune_exactly_under_moves_removals_and_odd_queries() {
         }
     }
     assert!(loose_frames > 10, "moves rarely made a node loose");
+}
+
+/// The default depth cap comes from the scene: cells about `R_max` wide, plus
+/// the slack levels (a cube 100 wide with `R_max` 2: 6 splits per axis + 3).
+/// A point cloud then stops at that depth instead of 40 (W7: 100k points took
+/// 4.7 s to build at 40); spheres above 2% of `R_max` still stop by the
+/// border-zone rule above the cap, exactly where they stopped before.
+#[test]
+fn default_depth_cap_follows_the_scene() {
+    assert_eq!(LooseKdConfig::depth_for(&cube(100.0), 2.0), 21);
+    assert_eq!(LooseKdConfig::new(cube(100.0), 2.0).max_depth, 21);
+    // Wider than the largest cap allows, or R_max as wide as the world.
+    assert_eq!(
+        LooseKdConfig::depth_for(&cube(1e9), 1e-3),
+        LooseKdConfig::DEFAULT_MAX_DEPTH
+    );
+    assert_eq!(
+        LooseKdConfig::depth_for(&cube(1.0), 5.0),
+        LooseKdConfig::DEPTH_SLACK
+    );
+    assert_eq!(
+        LooseKdConfig::depth_for(&cube(100.0), f32::NAN),
+        LooseKdConfig::DEFAULT_MAX_DEPTH
+    );
+
+    // A point cloud on a lattice 1 apart (R_max 2): nobody goes below the cap,
+    // and every point is found.
+    let mut t = LooseKdTree::new(cube(100.0), 2.0).unwrap();
+    let mut pts = Vec::new();
+    for i in 0..30 {
+        for j in 0..30 {
+            for k in 0..30 {
+                pts.push(vec3(
+                    i as f32 * 3.0 + 1.0,
+                    j as f32 * 3.0 + 1.0,
+                    k as f32 * 3.0 + 1.0,
+                ));
+            }
+        }
+    }
+    for (n, p) in pts.iter().enumerate() {
+        t.insert(Sphere::new(*p, 0.0), n).unwrap();
+    }
+    t.validate().unwrap();
+    let st = t.stats();
+    assert_eq!(st.max_depth, 21, "points stop at the scene's cap");
+    let mut deep = LooseKdTree::with_config(LooseKdConfig {
+        max_depth: LooseKdConfig::DEFAULT_MAX_DEPTH,
+        ..LooseKdConfig::new(cube(100.0), 2.0)
+    })
+    .unwrap();
+    for (n, p) in pts.iter().enumerate() {
+        deep.insert(Sphere::new(*p, 0.0), n).unwrap();
+    }
+    let deep_nodes = deep.stats().nodes;
+    assert!(
+        3 * st.nodes < deep_nodes,
+        "{} nodes at the scene's cap, {deep_nodes} at 40",
+        st.nodes
+    );
+    for (n, p) in pts.iter().enumerate().step_by(97) {
+        assert_eq!(t.within(*p, 0.0).unwrap().len(), 1, "point {n}");
+    }
+    // Spheres of W1's sizes stop where the border-zone rule puts them, above
+    // the cap: the same depths as with the old cap of 40.
+    let mut old = LooseKdTree::with_config(LooseKdConfig {
+        max_depth: LooseKdConfig::DEFAULT_MAX_DEPTH,
+        ..LooseKdConfig::new(cube(100.0), 2.0)
+    })
+    .unwrap();
+    let mut new = LooseKdTree::new(cube(100.0), 2.0).unwrap();
+    let mut rng = Pcg64::seed_from_u64(11);
+    for n in 0..5000 {
+        let c = vec3(
+            rng.gen_range(0.0..100.0),
+            rng.gen_range(0.0..100.0),
+            rng.gen_range(0.0..100.0),
+        );
+        let s = Sphere::new(c, rng.gen_range(0.05..2.0));
+        old.insert(s, n).unwrap();
+        new.insert(s, n).unwrap();
+    }
+    assert_eq!(old.stats(), new.stats());
 }

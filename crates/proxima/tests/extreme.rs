@@ -235,6 +235,64 @@ fn nearest_with_overflowing_distances<I: SpatialIndex<u32>>(make: &dyn Fn() -> I
 }
 per_index!(nearest_with_overflowing_distances);
 
+// ---- k nearest: ties and near-ties at the pruning bound ---------------------------
+
+/// The searches reject a candidate from its squared distance when it is surely
+/// beyond the k-th best (`overlap::distance_exceeds`) and compute the exact
+/// distance only for the rest. Objects whose distances are exactly equal,
+/// one `f32` apart, or exact rounding ties (`1 + 2^-24` rounds to even, to
+/// `1`), each twice (duplicates, radius 0 among them), around one point and
+/// in all six directions: every `k` and limit at those values gives brute
+/// force's answer, ids and distances bit for bit.
+fn nearest_ties_at_the_pruning_bound<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
+    let mut i = make();
+    let mut brute = BruteForce::new();
+    let (mut hi, mut hb) = (Vec::new(), Vec::new());
+    let p = Vec3::ONE;
+    let u = 2f32.powi(-24);
+    let mut id = 0u32;
+    for axis in 0..3 {
+        for sign in [1.0f32, -1.0] {
+            for delta in [0.0, 4.0 * u, 8.0 * u] {
+                for r in [0.0, u, 3.0 * u, 2.0 * u, 4.0 * u] {
+                    for _ in 0..2 {
+                        let mut c = p;
+                        c[axis] += sign * (1.0 + delta);
+                        let s = Sphere::new(c, r);
+                        hi.push(i.insert(s, id).unwrap());
+                        hb.push(brute.insert(s, id).unwrap());
+                        id += 1;
+                    }
+                }
+            }
+        }
+    }
+    let as_ids = |v: &[proxima::broad::Neighbor], hs: &[Handle]| -> Vec<(usize, f32)> {
+        v.iter()
+            .map(|n| (hs.iter().position(|&h| h == n.handle).unwrap(), n.distance))
+            .collect()
+    };
+    let n = id as usize;
+    for point in [p, p + vec3(u, 0.0, 0.0), p - vec3(0.0, 0.0, 2.0 * u)] {
+        for metric in [Metric::Surface, Metric::Center] {
+            for limit in [f32::INFINITY, 1.0, 1.0 + 2.0 * u, 1.0 - u, 0.0] {
+                for k in [1, 2, 3, 7, 12, 30, 31, 60, 61, 100, n - 1, n, n + 5] {
+                    let q = Nearest::new(point, k).metric(metric).within(limit);
+                    let (mut got, mut want) = (Vec::new(), Vec::new());
+                    i.nearest_into(&q, None, &mut got).unwrap();
+                    brute.nearest_into(&q, None, &mut want).unwrap();
+                    assert_eq!(
+                        as_ids(&got, &hi),
+                        as_ids(&want, &hb),
+                        "{point} {metric:?} limit {limit} k={k}"
+                    );
+                }
+            }
+        }
+    }
+}
+per_index!(nearest_ties_at_the_pruning_bound);
+
 // ---- sphere sweeps at extreme coordinates and radii --------------------------------
 
 /// Regressions (proptest, `tests/ops`): the hash grid's widened-segment walk

@@ -38,6 +38,25 @@ impl Metric {
             Metric::Center => overlap::point_sphere_distance(point, &Sphere::new(s.center, 0.0)),
         }
     }
+
+    /// [`Metric::distance`] if it is at most `bound`, else `None`: the
+    /// searches' per-candidate step. Most candidates lie beyond the current
+    /// k-th best, and [`overlap::distance_exceeds`] rejects them from the
+    /// squared centre distance alone (no square root, no rounding); only the
+    /// others get the correctly rounded distance, so the answer is the same
+    /// bit for bit. O(1).
+    #[inline]
+    pub(crate) fn distance_within(self, point: Vec3, s: &Sphere, bound: f32) -> Option<f32> {
+        let r = match self {
+            Metric::Surface => s.radius,
+            Metric::Center => 0.0,
+        };
+        if overlap::distance_exceeds(overlap::point_point_distance_sq(point, s.center), r, bound) {
+            return None;
+        }
+        let distance = self.distance(point, s);
+        (distance <= bound).then_some(distance)
+    }
 }
 
 /// A k-nearest-neighbours query: the (up to) `k` stored objects nearest to
@@ -338,16 +357,20 @@ pub(crate) fn may_overflow(point: Vec3, extent: &crate::geom::Aabb) -> bool {
 /// seen)` offers every object referenced from the cells of `slab` that was
 /// not referenced from any cell of `seen` (empty at first; `seen ∪ slab` is
 /// again a box), and may break to say that it offered everything (a store
-/// that gave up growing and scanned). `face(a, upper, k)` is a lower bound on
-/// the distance of every object whose cells all lie beyond the face of axis
-/// `a` starting at key `k` (above it if `upper`, else below), correctly
-/// rounded down; `f32::INFINITY` when nothing can lie there.
+/// that gave up growing and scanned). `face(a, upper, k)` is the squared
+/// distance ([`overlap::point_aabb_distance_sq`]) to a box holding every object
+/// whose cells all lie beyond the face of axis `a` starting at key `k` (above
+/// it if `upper`, else below); `f64::INFINITY` when nothing can lie there.
+/// Squared `f64` bounds tested with [`overlap::distance_exceeds`] cost no
+/// square root and never the exact rounding (a face's distance is often an
+/// exact `f32` rounding tie, which the correctly rounded distance resolves
+/// slowly).
 ///
 /// The box grows across the face with the smallest bound, one layer of cells
-/// at a time, and the search stops when that bound exceeds the heap's
-/// [`KBest::bound`] (strictly: an object at exactly the bound may still enter
-/// with a smaller handle) or every face reached the edge of `cells`. An object
-/// never seen has all its cells beyond one face, so its distance is at least
+/// at a time, and the search stops when that bound surely exceeds the heap's
+/// [`KBest::bound`] after rounding (strictly: an object at exactly the bound
+/// may still enter with a smaller handle) or every face reached the edge of
+/// `cells`. An object never seen has all its cells beyond one face, so its distance is at least
 /// that face's bound: the answer is brute force's. Growing the nearest face
 /// rather than whole rings (Chebyshev shells) costs the same in an even scene
 /// and far less for a query outside it, whose k nearest lie in the grid's
@@ -358,7 +381,7 @@ pub(crate) fn grow_box(
     start: KeyBox,
     cells: KeyBox,
     axes: usize,
-    face: impl Fn(usize, bool, i32) -> f32,
+    face: impl Fn(usize, bool, i32) -> f64,
     mut visit: impl FnMut(&mut KBest<'_>, &KeyBox, &KeyBox) -> ControlFlow<()>,
 ) {
     if cells.is_empty() {
@@ -374,15 +397,15 @@ pub(crate) fn grow_box(
         } else if !upper && seen.lo[a] > cells.lo[a] {
             face(a, false, seen.lo[a] - 1)
         } else {
-            f32::INFINITY
+            f64::INFINITY
         }
     };
-    let mut bounds = [[f32::INFINITY; 2]; 3];
+    let mut bounds = [[f64::INFINITY; 2]; 3];
     for (a, b) in bounds.iter_mut().enumerate().take(axes) {
         *b = [bound_of(&seen, a, false), bound_of(&seen, a, true)];
     }
     loop {
-        let mut next = (f32::INFINITY, 0, 0);
+        let mut next = (f64::INFINITY, 0, 0);
         for (a, b) in bounds.iter().enumerate().take(axes) {
             for (side, &d) in b.iter().enumerate() {
                 if d < next.0 {
@@ -391,7 +414,7 @@ pub(crate) fn grow_box(
             }
         }
         let (d, a, side) = next;
-        if d == f32::INFINITY || d > best.bound() {
+        if d == f64::INFINITY || overlap::distance_exceeds(d, 0.0, best.bound()) {
             return;
         }
         let mut slab = seen;

@@ -550,6 +550,50 @@ pub fn point_aabb_distance(p: Vec3, b: &Aabb) -> f32 {
     point_sphere_distance(p, &Sphere::new(p.clamp(b.min, b.max), 0.0))
 }
 
+/// `|c - p|²` evaluated in `f64` (the differences are exact, the squares and
+/// sums round three times: within `3u` relative of the exact value, never
+/// overflowing or underflowing for finite `f32` inputs). The cheap half of
+/// [`distance_exceeds`]. O(1), no square root.
+#[inline]
+pub fn point_point_distance_sq(p: Vec3, c: Vec3) -> f64 {
+    let (a, c) = (d3(p), d3(c));
+    let diff = [0, 1, 2].map(|i| a[i] - c[i]);
+    dot(diff, diff)
+}
+
+/// [`point_point_distance_sq`] from `p` to the closest point of the closed
+/// box `b` (`0` inside). O(1).
+#[inline]
+pub fn point_aabb_distance_sq(p: Vec3, b: &Aabb) -> f64 {
+    point_point_distance_sq(p, p.clamp(b.min, b.max))
+}
+
+/// Whether the correctly rounded distance `max(0, sqrt(s2) - r)` (as
+/// [`point_sphere_distance`] and [`point_aabb_distance`] compute it, `s2`
+/// from [`point_point_distance_sq`] or [`point_aabb_distance_sq`]) is surely
+/// greater than the `f32` `d`: the k-nearest searches' pruning test, which
+/// skips the square root and the rounding for the many candidates beyond the
+/// current k-th best. Conservative: `false` may still mean "greater" (within
+/// 1e-12 relative of the boundary, or `d` infinite), `true` never errs.
+///
+/// Why: the rounded distance exceeds `d` iff the exact one exceeds the
+/// midpoint `m` between `d` and the next `f32` up (at `m` exactly, ties to
+/// even may round down, so only `> m` counts), i.e. iff `|c - p| > m + r`,
+/// i.e. `|c - p|² > (m + r)²` (both sides non-negative as `m > 0`). `s2` is
+/// within `3u` of `|c - p|²` and `(m + r)²` is evaluated within `3u`; a margin
+/// of 1e-12 relative covers both. O(1): a few flops, no square root.
+#[inline]
+pub fn distance_exceeds(s2: f64, r: f32, d: f32) -> bool {
+    if d == f32::INFINITY {
+        return false;
+    }
+    // -0.0 (a limit of -0.0) is 0; `d + 1 ulp` overflows to ∞ at f32::MAX.
+    let d = if d > 0.0 { d } else { 0.0 };
+    let m = (d as f64 + f32::from_bits(d.to_bits() + 1) as f64) * 0.5;
+    let t = m + r as f64;
+    s2 > t * t * (1.0 + 1e-12)
+}
+
 /// Ray (or segment) against a box: the interval `[t0, t1]` of `f32`s that
 /// rounds the exact parameter interval of the ray inside the closed box outward
 /// (`t0` the largest `f32` not above the exact entry, `t1` the smallest not below

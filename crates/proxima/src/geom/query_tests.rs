@@ -334,6 +334,68 @@ fn point_sphere_distance_is_correctly_rounded() {
     assert!(zeros > 10_000, "{zeros}");
 }
 
+/// The k-nearest pruning test never rejects a candidate whose correctly
+/// rounded distance is at most the bound: at the distance itself, one `f32`
+/// either side of it, exact rounding ties (which round down to an even
+/// bound), `-0.0`, `f32::MAX` and `∞`; and it does reject clearly farther ones
+/// (a test that cannot fail would pass with `false` everywhere).
+#[test]
+fn distance_exceeds_never_rejects_what_rounds_within() {
+    let mut rng = Pcg64::seed_from_u64(27);
+    let mut rejected = 0;
+    let up = |y: f32| {
+        if y == f32::INFINITY {
+            y
+        } else {
+            f32::from_bits(y.to_bits() + 1)
+        }
+    };
+    for k in 0..200_000 {
+        let (p, c, r) = if k % 2 == 0 {
+            (cv(&mut rng), cv(&mut rng), coarse(&mut rng).abs())
+        } else {
+            let scale = 10f32.powi(rng.gen_range(-30..30));
+            let mut u = || rng.gen_range(-1.0f32..1.0) * scale;
+            (vec3(u(), u(), u()), vec3(u(), u(), u()), u().abs())
+        };
+        let s2 = point_point_distance_sq(p, c);
+        for r in [r, 0.0] {
+            let y = point_sphere_distance(p, &Sphere::new(c, r));
+            let down = if y > 0.0 { exact::f32_down(y) } else { 0.0 };
+            for d in [y, up(y), down, y * 0.5, 0.0, -0.0, f32::MAX, f32::INFINITY] {
+                let out = distance_exceeds(s2, r, d);
+                assert!(!out || y > d, "{p} {c} r {r}: {y} rejected at bound {d}");
+                rejected += out as u32;
+            }
+        }
+        // The box form: the distance to the box's closest point.
+        let b = Aabb::new(c.min(p * 0.5), c.max(p * 0.5));
+        let q = vec3(p.x, -p.y, c.z);
+        let yb = point_aabb_distance(q, &b);
+        for d in [yb, up(yb), 0.0] {
+            let out = distance_exceeds(point_aabb_distance_sq(q, &b), 0.0, d);
+            assert!(!out || yb > d, "{q} {b:?}: {yb} rejected at bound {d}");
+        }
+    }
+    assert!(rejected > 100_000, "{rejected}");
+    // |p - c| - r = 1 + 2^-24 exactly, which rounds (to even) to 1: kept at 1.
+    let (p, c, r) = (
+        vec3(1.0 + 2f32.powi(-23), 0.0, 0.0),
+        Vec3::ZERO,
+        2f32.powi(-24),
+    );
+    assert_eq!(point_sphere_distance(p, &Sphere::new(c, r)), 1.0);
+    assert!(!distance_exceeds(point_point_distance_sq(p, c), r, 1.0));
+    // Far apart near f32::MAX: the squares do not overflow in f64.
+    let (p, c) = (Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
+    assert!(!distance_exceeds(
+        point_point_distance_sq(p, c),
+        0.0,
+        f32::INFINITY
+    ));
+    assert!(distance_exceeds(point_point_distance_sq(p, c), 0.0, 1e38));
+}
+
 /// Distances exactly on a rounding boundary round to even; Pythagorean
 /// distances are exact; huge ones round to `f32::MAX` or `∞` as IEEE does.
 #[test]

@@ -50,10 +50,11 @@ impl<T, S: Store> CellGrid<T, S> {
             return;
         }
         let offer = |best: &mut KBest<'_>, slot: u32| {
-            let distance = q.metric.distance(q.point, &self.spheres[slot as usize]);
-            if distance <= best.bound()
-                && filter.map_or(true, |f| f.interacts(self.filters[slot as usize]))
-            {
+            let s = &self.spheres[slot as usize];
+            let Some(distance) = q.metric.distance_within(q.point, s, best.bound()) else {
+                return;
+            };
+            if filter.map_or(true, |f| f.interacts(self.filters[slot as usize])) {
                 best.offer(Neighbor {
                     handle: self.handle(slot),
                     distance,
@@ -84,9 +85,9 @@ impl<T, S: Store> CellGrid<T, S> {
                 }
                 let h = lat.padded(&h);
                 if h.min[a] > h.max[a] {
-                    f32::INFINITY
+                    f64::INFINITY
                 } else {
-                    overlap::point_aabb_distance(q.point, &h)
+                    overlap::point_aabb_distance_sq(q.point, &h)
                 }
             };
             let budget = LOOKUPS_PER_CELL * self.store.cell_count() as u64 + 64;

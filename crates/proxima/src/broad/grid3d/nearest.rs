@@ -35,10 +35,10 @@ impl<T> UniformGrid3d<T> {
         }
         let offer = |best: &mut KBest<'_>, slot: u32| {
             let s = &self.spheres[slot as usize];
-            let distance = q.metric.distance(q.point, s);
-            if distance <= best.bound()
-                && filter.map_or(true, |f| f.interacts(self.filters[slot as usize]))
-            {
+            let Some(distance) = q.metric.distance_within(q.point, s, best.bound()) else {
+                return;
+            };
+            if filter.map_or(true, |f| f.interacts(self.filters[slot as usize])) {
                 best.offer(Neighbor {
                     handle: self.resolve(slot).0,
                     distance,
@@ -74,9 +74,9 @@ impl<T> UniformGrid3d<T> {
                     h.max[a] = h.max[a].min(v + g.reach(v));
                 }
                 if h.min[a] > h.max[a] {
-                    f32::INFINITY
+                    f64::INFINITY
                 } else {
-                    overlap::point_aabb_distance(p, &h)
+                    overlap::point_aabb_distance_sq(p, &h)
                 }
             };
             grow_box(&mut best, start, cells, 3, face, |best, slab, _| {
@@ -86,7 +86,8 @@ impl<T> UniformGrid3d<T> {
                         let (y, z) = (y as u32, z as u32);
                         if x1 > x0 {
                             let row = g.loose_block([x0, y, z], [x1, y, z]);
-                            if overlap::point_aabb_distance(p, &row) > best.bound() {
+                            let d2 = overlap::point_aabb_distance_sq(p, &row);
+                            if overlap::distance_exceeds(d2, 0.0, best.bound()) {
                                 continue;
                             }
                         }

@@ -11,11 +11,12 @@ use crate::geom::overlap;
 impl<T> LooseKdTree<T> {
     /// The `k` nearest into `out`, nearest first, ties by handle.
     ///
-    /// A node is entered only if the distance from the point to its region
-    /// ([`overlap::point_aabb_distance`], correctly rounded) is at most the
-    /// heap's bound; the region contains every sphere of the subtree, and both
-    /// distances are correctly rounded (monotone), so no object of a pruned
-    /// subtree could have entered: the answer is brute force's, bit for bit.
+    /// A node is skipped only if the correctly rounded distance from the point
+    /// to its region is surely above the heap's bound
+    /// ([`overlap::distance_exceeds`] on [`overlap::point_aabb_distance_sq`]);
+    /// the region contains every sphere of the subtree, and the rounded
+    /// distances are monotone, so no object of a pruned subtree could have
+    /// entered: the answer is brute force's, bit for bit.
     /// Children are pushed farther first, so the nearer is searched first and
     /// the bound shrinks early. With a filter, subtrees whose filter bits
     /// cannot interact with it are skipped, and each candidate that could
@@ -31,13 +32,13 @@ impl<T> LooseKdTree<T> {
         if self.root == NIL || q.k == 0 {
             return;
         }
-        let mut stack = FixedStack::<(u32, f32)>::new();
-        let d0 = overlap::point_aabb_distance(q.point, &self.region(&self.nodes[self.root]));
-        if d0 <= best.bound() {
+        let mut stack = FixedStack::<(u32, f64)>::new();
+        let d0 = overlap::point_aabb_distance_sq(q.point, &self.region(&self.nodes[self.root]));
+        if !overlap::distance_exceeds(d0, 0.0, best.bound()) {
             stack.push((self.root, d0));
         }
         while let Some((n, d)) = stack.pop() {
-            if d > best.bound() {
+            if overlap::distance_exceeds(d, 0.0, best.bound()) {
                 continue;
             }
             let node = &self.nodes[n];
@@ -45,20 +46,19 @@ impl<T> LooseKdTree<T> {
                 continue;
             }
             for (p, s) in node.range().zip(&self.store.sphere[node.range()]) {
-                let distance = q.metric.distance(q.point, s);
-                if distance <= best.bound() {
+                if let Some(distance) = q.metric.distance_within(q.point, s, best.bound()) {
                     let (handle, of, _) = self.store.full(p);
                     if filter.map_or(true, |f| f.interacts(of)) {
                         best.offer(Neighbor { handle, distance });
                     }
                 }
             }
-            let mut next = [(NIL, f32::INFINITY); 2];
+            let mut next = [(NIL, f64::INFINITY); 2];
             for (side, e) in next.iter_mut().enumerate() {
                 let c = node.child[side];
                 if c != NIL {
-                    let dc = overlap::point_aabb_distance(q.point, &self.region(&self.nodes[c]));
-                    if dc <= best.bound() {
+                    let dc = overlap::point_aabb_distance_sq(q.point, &self.region(&self.nodes[c]));
+                    if !overlap::distance_exceeds(dc, 0.0, best.bound()) {
                         *e = (c, dc);
                     }
                 }

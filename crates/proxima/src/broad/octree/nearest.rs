@@ -12,12 +12,14 @@ use crate::geom::overlap;
 impl<T> LinearOctree<T> {
     /// The `k` nearest into `out`, nearest first, ties by handle.
     ///
-    /// A subtree is entered only if the distance from the point to its loose
-    /// box ([`overlap::point_aabb_distance`], correctly rounded) is at most the
-    /// heap's bound: the loose box contains every sphere below it (`validate`
-    /// checks it) and both distances are correctly rounded, hence monotone, so
-    /// a pruned subtree holds nothing that could have entered and the answer
-    /// is brute force's, bit for bit. Octants are searched nearest first (at
+    /// A subtree is skipped only if the correctly rounded distance from the
+    /// point to its loose box is surely above the heap's bound
+    /// ([`overlap::distance_exceeds`] on [`overlap::point_aabb_distance_sq`]):
+    /// the loose box contains every sphere below it (`validate` checks it) and
+    /// the rounded distances are monotone, so a pruned subtree holds nothing
+    /// that could have entered and the answer is brute force's, bit for bit.
+    /// Candidates are tested the same way before their exact distance
+    /// (`Metric::distance_within`). Octants are searched nearest first (at
     /// most 8 sorted on the stack per level). The filter is checked at each
     /// candidate that could enter. No allocation once `out` holds `k` entries.
     pub(super) fn nearest_tree(
@@ -31,7 +33,7 @@ impl<T> LinearOctree<T> {
             return;
         }
         let n = &self.nodes[self.root];
-        let d0 = overlap::point_aabb_distance(q.point, &self.loose_of([0; 3], 0, n.max_extent));
+        let d0 = overlap::point_aabb_distance_sq(q.point, &self.loose_of([0; 3], 0, n.max_extent));
         self.nearest_node(self.root, [0; 3], 0, d0, q, filter, &mut best);
         best.finish();
     }
@@ -42,12 +44,12 @@ impl<T> LinearOctree<T> {
         i: u32,
         c: [u32; 3],
         d: u32,
-        dist: f32,
+        dist_sq: f64,
         q: &Nearest,
         filter: Option<Filter>,
         best: &mut KBest<'_>,
     ) {
-        if dist > best.bound() {
+        if overlap::distance_exceeds(dist_sq, 0.0, best.bound()) {
             return;
         }
         let n = &self.nodes[i];
@@ -56,10 +58,11 @@ impl<T> LinearOctree<T> {
         }
         if n.leaf {
             for it in &n.items {
-                let distance = q.metric.distance(q.point, &it.sphere);
-                if distance <= best.bound()
-                    && filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter))
-                {
+                let Some(distance) = q.metric.distance_within(q.point, &it.sphere, best.bound())
+                else {
+                    continue;
+                };
+                if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
                     best.offer(Neighbor {
                         handle: it.handle,
                         distance,
@@ -68,7 +71,7 @@ impl<T> LinearOctree<T> {
             }
             return;
         }
-        let mut order = [(0.0f32, 0u32, [0u32; 3]); 8];
+        let mut order = [(0.0f64, 0u32, [0u32; 3]); 8];
         let mut m = 0;
         for (k, &ch) in n.children.iter().enumerate() {
             if ch == NONE {
@@ -76,13 +79,23 @@ impl<T> LinearOctree<T> {
             }
             let cc = child_coords(c, k);
             let loose = self.loose_of(cc, d + 1, self.nodes[ch].max_extent);
-            let dc = overlap::point_aabb_distance(q.point, &loose);
-            if dc <= best.bound() {
+            let dc = overlap::point_aabb_distance_sq(q.point, &loose);
+            if !overlap::distance_exceeds(dc, 0.0, best.bound()) {
                 order[m] = (dc, ch, cc);
                 m += 1;
             }
         }
-        order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        // Insertion sort: at most 8 entries, inline (the library sort's call
+        // and generic comparisons cost ~10% of a query, callgrind W7).
+        for j in 1..m {
+            let e = order[j];
+            let mut i = j;
+            while i > 0 && order[i - 1].0 > e.0 {
+                order[i] = order[i - 1];
+                i -= 1;
+            }
+            order[i] = e;
+        }
         for &(dc, ch, cc) in &order[..m] {
             self.nearest_node(ch, cc, d + 1, dc, q, filter, best);
         }

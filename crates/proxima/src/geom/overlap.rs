@@ -329,7 +329,7 @@ fn sweep_sphere_misses(sweep: &SphereSweep, s: &Sphere) -> bool {
     let (rho2, dd, mm) = (rho * rho, d.length_squared(), m.length_squared());
     let mmdd = mm * dd;
     // Written so that a NaN fails them.
-    if !(rho2 >= TINY && dd >= TINY && dd < HUGE && mmdd < HUGE) {
+    if !(rho2 >= TINY && (TINY..HUGE).contains(&dd) && mmdd < HUGE) {
         return false;
     }
     let b = rho2 * dd;

@@ -286,7 +286,63 @@ impl Line for RayBall<'_> {
 /// for near-ties.
 #[inline]
 pub fn sweep_sphere(sweep: &SphereSweep, s: &Sphere) -> Option<f32> {
+    if sweep_sphere_misses(sweep, s) {
+        return None;
+    }
     first_touch(&SweepBall { sweep, s })
+}
+
+/// Conservative `f32` pre-test of [`sweep_sphere`]: `true` only if the sweep
+/// certainly misses `s` (then `sweep_sphere` is `None`); `false` means
+/// "undecided", and the exact test runs. Most candidates of an index walk are
+/// clear misses; this rejects them in ~35 `f32` flops instead of the `f64`
+/// filters with error bounds (~120 flops). It answers "miss" when the
+/// distance from the centre to the segment certainly exceeds `ρ = r + R`, in
+/// one of three ways: the infinite line passes farther than `ρ`
+/// (`|m × d|² > ρ²|d|²`, `m = from - c`, `d = to - from`), or the sweep moves
+/// away from the centre from the start on (`m·d >= 0`, the minimum at `t = 0`)
+/// and starts farther than `ρ`, or it still approaches at the end
+/// (`n·d < 0`, `n = to - c`, the minimum at `t = 1`) and ends farther.
+///
+/// Why it is conservative (u = 2^-24): without underflow or overflow every
+/// `f32` operation is exact up to a factor `1 + δ`, `|δ| <= u`. `m`, `d`, `n`
+/// and `ρ` round once; `|d|²`, `|m|²`, `|n|²` are within 5u relative, `ρ²|d|²`
+/// within 9u; each component of `m × d` is within
+/// `4u (|m_i d_j| + |m_j d_i|) <= 4u |m||d|` of the exact one, so
+/// `|m × d|²` is within `20u |m|²|d|²`, and `m·d`, `n·d` within
+/// `5u |m||d| <= 3u (|m|² + |d|²)`. Every comparison below demands a gap of
+/// `2^-16 = 256u` times the sum of those magnitudes: more than 10× the
+/// bound. The guards keep the inputs where that model holds: `ρ² >= 2^-60`
+/// and `|d|² >= 2^-60` make every margin at least `2^-136`, far above the
+/// absolute error `~2^-144` that underflowing products and squares may add;
+/// `|d|² < 2^100` and `|m|²|d|² < 2^100` keep every product, square and
+/// dot product finite (a sum of margins may overflow to `∞`: undecided). A NaN or an
+/// overflow fails a guard: undecided.
+#[inline]
+fn sweep_sphere_misses(sweep: &SphereSweep, s: &Sphere) -> bool {
+    const EPS: f32 = 1.0 / 65536.0; // 2^-16
+    const TINY: f32 = 1.0 / 1_152_921_504_606_846_976.0; // 2^-60
+    const HUGE: f32 = 1_152_921_504_606_846_976.0 * 1_099_511_627_776.0; // 2^100
+    let d = sweep.to - sweep.from;
+    let m = sweep.from - s.center;
+    let rho = s.radius + sweep.radius;
+    let (rho2, dd, mm) = (rho * rho, d.length_squared(), m.length_squared());
+    let mmdd = mm * dd;
+    // Written so that a NaN fails them.
+    if !(rho2 >= TINY && (TINY..HUGE).contains(&dd) && mmdd < HUGE) {
+        return false;
+    }
+    let b = rho2 * dd;
+    if m.cross(d).length_squared() > b + EPS * (mmdd + b) {
+        return true; // the whole line passes farther than ρ
+    }
+    let far = |pp: f32| pp > rho2 + EPS * (pp + rho2);
+    if m.dot(d) > EPS * (mm + dd) && far(mm) {
+        return true; // receding from the start, which is outside
+    }
+    let n = sweep.to - s.center;
+    let nn = n.length_squared();
+    n.dot(d) < -EPS * (nn + dd) && far(nn) // approaching at the end, outside
 }
 
 /// A sphere sweep and a stored sphere, as the shared line–ball test sees them.

@@ -455,3 +455,79 @@ fn box_distance_bounds_the_spheres_inside() {
         }
     }
 }
+
+/// The `f32` pre-test of `sweep_sphere` never answers "miss" for a sweep the
+/// exact test (independent, above) says touches: near-tangent grazes of the
+/// side, of the start cap and of the end cap, at magnitudes from subnormal
+/// to 1e30 (centres far from the origin, long and short sweeps, tiny and
+/// zero radii, and mixed ones). It must also do its work: it rejects most
+/// clear misses of moderate inputs.
+#[test]
+fn sweep_miss_pretest_is_conservative() {
+    let mut rng = Pcg64::seed_from_u64(23);
+    let (mut touched, mut rejected, mut clear, mut clear_rejected) = (0u32, 0u32, 0u32, 0u32);
+    for k in 0..300_000 {
+        let mut u = || rng.gen_range(-1.0f32..1.0);
+        let (scale, offset, rscale) = match k % 6 {
+            0 => (1.0f32, 0.0f32, 1.0f32),
+            1 => (1e-3, 1e6, 1e-3),
+            2 => (1e20, 1e30, 1e20),
+            3 => (1.0, 0.0, 1e-30),
+            4 => (1e-38, 0.0, 1e-40),
+            _ => (1e4, 1e8, 1e-6),
+        };
+        let base = vec3(u(), u(), u()) * offset;
+        let c = base + vec3(u(), u(), u()) * scale;
+        let dir = vec3(u(), u(), u()).normalize_or(Vec3::X);
+        let side = dir.any_orthonormal_vector();
+        let (r, rr) = match k % 5 {
+            0 => (0.0, u().abs() * rscale),
+            1 => (u().abs() * rscale, 0.0),
+            _ => (u().abs() * rscale, u().abs() * rscale),
+        };
+        let rho = r + rr;
+        let len = scale * [1e-6f32, 0.3, 1.0, 30.0][rng.gen_range(0..4)];
+        let mut u = || rng.gen_range(-1.0f32..1.0);
+        // Which part of the capsule the centre grazes: its side, the start
+        // cap or the end cap; at a distance rho (1 + e), |e| from 1e-7 (where
+        // only the exact test decides) to 1e-2 (where the pre-test does).
+        let off = rho * (1.0 + u() * [1e-7f32, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2][k % 7 % 6]);
+        let (from, to) = match k % 3 {
+            0 => {
+                let mid = c + side * off;
+                (mid - dir * len * 0.5, mid + dir * len * 0.5)
+            }
+            1 => {
+                let from = c + (dir * u().abs() - side * u()).normalize_or(dir) * off;
+                (from, from + dir * len)
+            }
+            _ => {
+                let to = c - (dir * u().abs() + side * u()).normalize_or(dir) * off;
+                (to - dir * len, to)
+            }
+        };
+        let sw = SphereSweep::new(from, to, rr);
+        let s = Sphere::new(c, r);
+        if !(sw.validate().is_ok() && s.validate().is_ok()) {
+            continue;
+        }
+        let miss = sweep_sphere_misses(&sw, &s);
+        if sweep_touches_exact(&sw, &s) {
+            touched += 1;
+            assert!(!miss, "pre-test rejects a touched sphere: {sw:?} {s:?}");
+        }
+        rejected += miss as u32;
+        // A clear miss (distance about twice the radii) of moderate inputs.
+        let far = SphereSweep::new(from + side * (2.0 * rho), to + side * (2.0 * rho), rr);
+        if k % 6 == 0 && rho > 1e-3 && !sweep_touches_exact(&far, &s) {
+            clear += 1;
+            clear_rejected += sweep_sphere_misses(&far, &s) as u32;
+        }
+    }
+    // Both sides of the boundary, and misses near it decided by the pre-test.
+    assert!(touched > 50_000 && rejected > 3_000, "{touched} {rejected}");
+    assert!(
+        clear_rejected * 10 > clear * 9,
+        "{clear_rejected} of {clear}"
+    );
+}

@@ -254,13 +254,16 @@ impl<T> UniformGrid3d<T> {
                 let Some((x0, x1, _)) = path.span(&path.restrict(&bk, 1, j), 0) else {
                     continue;
                 };
-                self.visit_row(
-                    cast,
-                    [g.coord(x0, 0), j, k],
-                    g.coord(x1, 0),
-                    Frustum::ALL_PLANES,
-                    f,
-                )?;
+                // No cell box test here (unlike `visit_row`): the path meets
+                // every cell's centres widened by the reach by construction,
+                // and a cast never classifies a box `Inside`, so that test
+                // could only skip a cell the exact tests reject anyway.
+                let first = g.index([g.coord(x0, 0), j, k]);
+                for c in first..=first + (g.coord(x1, 0) - g.coord(x0, 0)) {
+                    if self.store.count(c) > 0 {
+                        self.test_cell(cast, c, Relation::Intersecting, Frustum::ALL_PLANES, f)?;
+                    }
+                }
             }
         }
         ControlFlow::Continue(())

@@ -31,10 +31,10 @@
 //! and runs the exact test only on the few candidates; only a reported pair goes
 //! back to the object array for its handle and payload. A node's own objects are appended
 //! to the carried set first, so "own against ancestors" and "own against own" are
-//! the same scan. A node whose
-//! own and carried objects are many (typically a node high in the tree holding
-//! big spheres spread over its box) sweeps them on its split axis instead of
-//! testing all pairs; the carried set is narrowed at each level except before a
+//! the same scan. A node with many own objects (they stop where `r >= h`, so
+//! they are spread over its whole box) sweeps them and the carried set on its
+//! split axis instead of testing all pairs, through the same scan over windows
+//! of a bucket order; the carried set is narrowed at each level except before a
 //! small leaf, where the copy would cost more than the tests it saves.
 
 use super::node::{FixedStack, NIL};
@@ -46,14 +46,14 @@ use glam::{Vec3, Vec4};
 use std::ops::ControlFlow;
 use std::sync::{Mutex, TryLockError};
 
-/// Below this many objects in a node (own plus carried), the node's tests are
-/// all-pairs through the vectorized [`Carried::scan`]; from it on they use a sweep
-/// on the split axis. With the scan's eight tests per step, all-pairs stays
-/// cheaper than sorting well past the 48 that suited the scalar test (W1, 10k:
-/// 128 measured a little faster than 48, and no worse than never sweeping). With
-/// the depth-first object array and density 0.15, W1 at 100k ran its pair search
-/// 15–25% faster with 256 than with 128 (512 about the same as 256).
-const SWEEP_MIN: usize = 256;
+/// Below this many own objects in a node, the node's tests are all-pairs
+/// through the vectorized [`Carried::scan`]; from it on they use the bucketed
+/// sweep on the split axis (`LooseKdTree::sweep`, O(k) set-up for k own and
+/// carried objects). W1 100k (callgrind, 2 frames): the sweep from 16 or 32 own
+/// objects cut the pair search's instructions by 15%, the same for both; the
+/// nodes it runs on hold ~114 objects. The earlier comparison sort with a
+/// scalar sweep paid only from 256 objects (own plus carried).
+const SWEEP_MIN: usize = 32;
 
 /// Leaves with fewer objects are tested against their parent's carried set
 /// without narrowing it first (see `worth_filtering`).
@@ -127,6 +127,16 @@ impl Carried {
         for (i, s) in spheres.iter().enumerate() {
             self.put(s, (start + i) as u32, keep(start + i, s));
         }
+    }
+
+    /// Copies entry `i` to position `k` (past `len`: see `reserve`).
+    #[inline]
+    fn copy_to(&mut self, i: usize, k: usize) {
+        self.x[k] = self.x[i];
+        self.y[k] = self.y[i];
+        self.z[k] = self.z[i];
+        self.r[k] = self.r[i];
+        self.org[k] = self.org[i];
     }
 
     /// Entry `i` as a sphere.
@@ -248,14 +258,24 @@ impl Carried {
         mut hit: impl FnMut(usize) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let (sx, sy, sz, sr) = (s.center.x, s.center.y, s.center.z, s.radius);
+        // Cut once, so the chunks below need no bounds checks.
+        let (xs, ys, zs, rs) = (
+            &self.x[from..to],
+            &self.y[from..to],
+            &self.z[from..to],
+            &self.r[from..to],
+        );
+        let quads = xs
+            .chunks_exact(LANES)
+            .zip(ys.chunks_exact(LANES))
+            .zip(zs.chunks_exact(LANES).zip(rs.chunks_exact(LANES)));
         let mut i = from;
-        while i + LANES <= to {
-            let lanes = |v: &[f32]| Vec4::from_slice(&v[i..i + LANES]);
+        for ((cx, cy), (cz, cr)) in quads {
             let mut mask = overlap::sphere_sphere_candidates4(
-                lanes(&self.x),
-                lanes(&self.y),
-                lanes(&self.z),
-                lanes(&self.r),
+                Vec4::from_slice(cx),
+                Vec4::from_slice(cy),
+                Vec4::from_slice(cz),
+                Vec4::from_slice(cr),
                 s,
             );
             while mask != 0 {
@@ -300,17 +320,22 @@ impl Carried {
     }
 }
 
-/// The pair search's buffers: the carried set and the sweep's sort keys (lower
-/// end on the sweep axis, index into the carried set).
+/// The pair search's buffers: the carried set and the sweep's bucket sort
+/// (per entry its bucket, per bucket its first and then its end slot, per slot
+/// the entry it holds).
 #[derive(Default)]
 pub(super) struct Buffers {
     pub(super) c: Carried,
-    keys: Vec<(f32, u32)>,
+    bucket: Vec<u32>,
+    start: Vec<u32>,
+    order: Vec<u32>,
 }
 
 impl Buffers {
     fn heap_bytes(&self) -> usize {
-        self.c.heap_bytes() + self.keys.capacity() * std::mem::size_of::<(f32, u32)>()
+        self.c.heap_bytes()
+            + (self.bucket.capacity() + self.start.capacity() + self.order.capacity())
+                * std::mem::size_of::<u32>()
     }
 }
 
@@ -483,7 +508,7 @@ impl<T> LooseKdTree<T> {
             // sphere load each; the loop below rebuilds them from the carried
             // set, which cost W1 100k 5% more instructions).
             b.c.push_node(start, own, |_, _| true);
-            if own.len() > 1 && b.c.len() - active >= SWEEP_MIN {
+            if own.len() >= SWEEP_MIN {
                 return self.sweep(active, base, node.axis as usize, b, f);
             }
             let c = &b.c;
@@ -495,7 +520,7 @@ impl<T> LooseKdTree<T> {
         // Inert objects stay out: neither carried down nor tested here.
         b.c.push_node(start, own, |p, _| self.pairable(p));
         let end = b.c.len();
-        if end - base > 1 && end - active >= SWEEP_MIN {
+        if end - base >= SWEEP_MIN {
             self.sweep(active, base, node.axis as usize, b, f)?;
         } else {
             let c = &b.c;
@@ -536,16 +561,26 @@ impl<T> LooseKdTree<T> {
 
     /// The pairs among the carried entries `active..` except those between two
     /// entries below `own` (carried objects were paired higher up), by a sweep on
-    /// `axis`: the objects are sorted by their lower end on `axis`, and each is
-    /// tested only against the following ones that start before it ends. The big
-    /// objects of a node high in the tree are spread over its whole box, so most of
-    /// them are far apart and the sweep skips them; sorting costs O(k log k) for k
-    /// objects.
+    /// `axis`: the entries are ordered by the bucket of their lower end on
+    /// `axis` (a counting sort, one bucket per entry over the range of the lower
+    /// ends) and copied in that order to the end of the carried set; each is then
+    /// tested, four at a time through [`Carried::scan`], only against the
+    /// following ones up to the end of the bucket where it ends. A node's own
+    /// objects are spread over its whole box (they stop there because `r >= h`,
+    /// wherever their centre is), so most of them are far apart on the node's
+    /// longest axis, the one it splits: W1 100k keeps ~114 objects in each node of
+    /// depth 9, and all-pairs tested each against ~57 of its own. O(k) for k
+    /// entries, plus the tests in the windows.
     ///
     /// Why no pair is missed: overlapping spheres (closed, as `overlap`
     /// computes it in `f32`) have centres at most `r_a + r_b` apart on every axis,
-    /// so their intervals on `axis` meet; `eps` absorbs the rounding of the
-    /// interval ends.
+    /// so the later one's lower end is at most the earlier one's upper end (`eps`
+    /// absorbs the rounding of the interval ends); the bucket map is
+    /// non-decreasing, so the later one's bucket is at most the bucket of that
+    /// upper end, and the earlier one's window reaches it. Each pair is tested
+    /// once, from the entry that comes first in the new order; a window that
+    /// runs past the overlapping entries (by a bucket, or up to three lanes)
+    /// only tests pairs that do not overlap.
     fn sweep(
         &self,
         active: usize,
@@ -554,28 +589,63 @@ impl<T> LooseKdTree<T> {
         b: &mut Buffers,
         f: &mut impl FnMut(Handle, &T, Handle, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let c = &b.c;
-        b.keys.clear();
-        b.keys
-            .extend((active..c.len()).map(|i| (c.end(i, axis, false), i as u32)));
-        b.keys.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        let keys = &b.keys[..];
-        for (k, &(_, i)) in keys.iter().enumerate() {
-            let i = i as usize;
-            let si = c.sphere(i);
-            let hi = c.end(i, axis, true) + self.eps;
-            for &(lo, j) in &keys[k + 1..] {
-                if lo > hi {
-                    break;
+        let c = &mut b.c;
+        let end = c.len();
+        let m = end - active;
+        let (mut lo_min, mut lo_max) = (f32::INFINITY, f32::NEG_INFINITY);
+        for i in active..end {
+            let lo = c.end(i, axis, false);
+            lo_min = lo_min.min(lo);
+            lo_max = lo_max.max(lo);
+        }
+        // One bucket per entry over [lo_min, lo_max]. The map is non-decreasing
+        // in `x` (a rounded difference, a positive factor, a saturating cast and
+        // a clamp); a degenerate range puts everything in bucket 0.
+        let scale = m as f32 / (lo_max - lo_min);
+        let scale = if scale.is_finite() { scale } else { 0.0 };
+        let bucket_of = |x: f32| (((x - lo_min) * scale) as usize).min(m - 1);
+        b.bucket.clear();
+        b.start.clear();
+        b.start.resize(m + 1, 0);
+        for i in active..end {
+            let k = bucket_of(c.end(i, axis, false));
+            b.bucket.push(k as u32);
+            b.start[k + 1] += 1;
+        }
+        for k in 0..m {
+            b.start[k + 1] += b.start[k];
+        }
+        // Scatter: afterwards `start[k]` is the end of bucket `k`.
+        b.order.clear();
+        b.order.resize(m, 0);
+        c.reserve(m);
+        for (i, &k) in (active..end).zip(&b.bucket) {
+            let slot = &mut b.start[k as usize];
+            b.order[*slot as usize] = i as u32;
+            c.copy_to(i, end + *slot as usize);
+            *slot += 1;
+        }
+        c.len = end + m;
+        let (c, order, bucket_end) = (&b.c, &b.order[..], &b.start[..]);
+        let mut result = ControlFlow::Continue(());
+        for (slot, &i) in order.iter().enumerate() {
+            let carried = (i as usize) < own;
+            let at = end + slot;
+            let hi = c.end(at, axis, true) + self.eps;
+            let stop = end + bucket_end[bucket_of(hi)] as usize;
+            let s = c.sphere(at);
+            result = c.scan(at + 1, stop, &s, |j| {
+                if carried && (order[j - end] as usize) < own {
+                    return ControlFlow::Continue(());
                 }
-                let j = j as usize;
-                if (i < own && j < own) || !overlap::sphere_sphere(&si, &c.sphere(j)) {
-                    continue;
-                }
-                self.report(c, i, j, f)?;
+                self.report(c, at, j, f)
+            });
+            if result.is_break() {
+                break;
             }
         }
-        ControlFlow::Continue(())
+        b.c.truncate(end);
+        result
     }
 
     /// Every pair between the subtrees of the two children of `a`. Uses the

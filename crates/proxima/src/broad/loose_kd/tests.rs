@@ -464,6 +464,79 @@ fn crowded_nodes_sweep_finds_exactly_touching_pairs() {
 }
 
 #[test]
+fn bucketed_sweep_with_degenerate_and_overflowing_ranges() {
+    // Nodes with many own objects take the bucketed sweep. Its bucket map must
+    // stay non-decreasing when the lower ends are all equal (range 0), when
+    // their range overflows f32 (far outside the world box), and with inert
+    // objects and filters mixed in; every case against brute force.
+    let world = cube(20.0);
+    let scenes: Vec<Vec<Sphere>> = vec![
+        // 40 identical spheres big enough to stop at the root: range 0.
+        vec![Sphere::new(vec3(10.0, 10.0, 10.0), 1.9); 40],
+        // Lower ends from -3e38 to 3e38: their range is infinite.
+        (0..48)
+            .map(|i| {
+                let x = if i % 2 == 0 { -3e38 } else { 3e38 };
+                Sphere::new(vec3(x, (i / 2) as f32 * 0.5, 0.0), 1.9)
+            })
+            .collect(),
+        // A crowd with a few huge outliers, so most buckets stay empty and the
+        // windows of the outliers' neighbours end in the same bucket.
+        (0..120)
+            .map(|i| {
+                let t = i as f32;
+                let c = if i % 30 == 0 {
+                    vec3(1e30 * (t - 60.0), 3.0, 3.0)
+                } else {
+                    vec3(
+                        10.0 + (t * 0.37).sin() * 4.0,
+                        10.0 + (t * 0.71).cos() * 4.0,
+                        10.0 + (t * 0.13).sin(),
+                    )
+                };
+                Sphere::new(c, 1.5 + (t * 0.29).sin().abs() * 0.4)
+            })
+            .collect(),
+    ];
+    for (k, spheres) in scenes.iter().enumerate() {
+        for filtered in [false, true] {
+            let mut t = LooseKdTree::with_config(LooseKdConfig {
+                density: 0.2,
+                ..LooseKdConfig::new(world, 2.0)
+            })
+            .unwrap();
+            let mut b = BruteForce::new();
+            for (i, s) in spheres.iter().enumerate() {
+                let v = i as u32;
+                // Every third object inert, every fifth in a group of its own.
+                let f = match (filtered, i % 3, i % 5) {
+                    (false, _, _) => Filter::ALL,
+                    (true, 0, _) => Filter::new(0, u32::MAX),
+                    (true, _, 0) => Filter::new(2, 2),
+                    _ => Filter::new(1, 1),
+                };
+                t.insert_with_filter(*s, f, v).unwrap();
+                b.insert_with_filter(*s, f, v).unwrap();
+            }
+            assert!(
+                t.stats().max_items_per_node >= 32,
+                "scene {k}: the sweep must run"
+            );
+            let expect = value_pairs(&b);
+            assert!(!expect.is_empty(), "scene {k}");
+            assert_eq!(value_pairs(&t), expect, "scene {k}, filtered {filtered}");
+            // A search stopped at its first pair reports exactly one.
+            let mut seen = 0;
+            let _ = t.for_each_pair(|_, _, _, _| {
+                seen += 1;
+                ControlFlow::Break(())
+            });
+            assert_eq!(seen, 1, "scene {k}");
+        }
+    }
+}
+
+#[test]
 fn nested_pair_searches_use_their_own_buffers() {
     let mut t = LooseKdTree::with_config(LooseKdConfig {
         density: 0.2,

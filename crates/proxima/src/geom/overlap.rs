@@ -648,7 +648,7 @@ pub fn distance_exceeds(s2: f64, r: f32, d: f32) -> bool {
 /// or `f32::MAX` (nothing surely exceeds those). The searches keep it beside
 /// their bound, which changes far less often than it is tested. O(1).
 #[inline]
-pub fn distance_midpoint(d: f32) -> f64 {
+pub(crate) fn distance_midpoint(d: f32) -> f64 {
     if d == f32::INFINITY {
         return f64::INFINITY;
     }
@@ -661,7 +661,7 @@ pub fn distance_midpoint(d: f32) -> f64 {
 /// of radius `r` and the midpoint `m` ([`distance_midpoint`]): `(m + r)²`
 /// with the 1e-12 relative margin; `∞` for an infinite `m`. O(1).
 #[inline]
-pub fn exceeds_threshold(m: f64, r: f32) -> f64 {
+pub(crate) fn exceeds_threshold(m: f64, r: f32) -> f64 {
     let t = m + r as f64;
     t * t * (1.0 + 1e-12)
 }

@@ -267,31 +267,88 @@ fn nearest_ties_at_the_pruning_bound<I: SpatialIndex<u32>>(make: &dyn Fn() -> I)
             }
         }
     }
-    let as_ids = |v: &[proxima::broad::Neighbor], hs: &[Handle]| -> Vec<(usize, f32)> {
-        v.iter()
-            .map(|n| (hs.iter().position(|&h| h == n.handle).unwrap(), n.distance))
-            .collect()
-    };
     let n = id as usize;
     for point in [p, p + vec3(u, 0.0, 0.0), p - vec3(0.0, 0.0, 2.0 * u)] {
         for metric in [Metric::Surface, Metric::Center] {
             for limit in [f32::INFINITY, 1.0, 1.0 + 2.0 * u, 1.0 - u, 0.0] {
                 for k in [1, 2, 3, 7, 12, 30, 31, 60, 61, 100, n - 1, n, n + 5] {
                     let q = Nearest::new(point, k).metric(metric).within(limit);
-                    let (mut got, mut want) = (Vec::new(), Vec::new());
-                    i.nearest_into(&q, None, &mut got).unwrap();
-                    brute.nearest_into(&q, None, &mut want).unwrap();
-                    assert_eq!(
-                        as_ids(&got, &hi),
-                        as_ids(&want, &hb),
-                        "{point} {metric:?} limit {limit} k={k}"
-                    );
+                    assert_nearest_as_brute(&i, &brute, (&hi, &hb), &q);
                 }
             }
         }
     }
 }
 per_index!(nearest_ties_at_the_pruning_bound);
+
+/// `index` answers `q` as `brute` does: the same objects (ids by insertion
+/// order, `hs` the two handle lists), in order, at the same distances bit for
+/// bit.
+fn assert_nearest_as_brute<I: SpatialIndex<u32>>(
+    index: &I,
+    brute: &BruteForce<u32>,
+    hs: (&[Handle], &[Handle]),
+    q: &Nearest,
+) {
+    let as_ids = |v: &[proxima::broad::Neighbor], hs: &[Handle]| -> Vec<(usize, u32)> {
+        v.iter()
+            .map(|n| {
+                let id = hs.iter().position(|&h| h == n.handle).unwrap();
+                (id, n.distance.to_bits())
+            })
+            .collect()
+    };
+    let (mut got, mut want) = (Vec::new(), Vec::new());
+    index.nearest_into(q, None, &mut got).unwrap();
+    brute.nearest_into(q, None, &mut want).unwrap();
+    assert_eq!(as_ids(&got, hs.0), as_ids(&want, hs.1), "{q:?}");
+}
+
+/// The bounded candidate set keeps a sorted buffer up to k = 256 and a heap
+/// beyond: 640 objects on a few shells around the point (exact ties, one-ulp
+/// near-ties and duplicates, radius 0 among them), queried with `k` around
+/// the switch and past the count, both metrics, with and without a limit on
+/// a shell: brute force's ids and distances bit for bit, in order.
+fn nearest_k_around_the_sorted_limit<I: SpatialIndex<u32>>(make: &dyn Fn() -> I) {
+    let mut i = make();
+    let mut brute = BruteForce::new();
+    let (mut hi, mut hb) = (Vec::new(), Vec::new());
+    let p = vec3(0.5, -2.0, 3.0);
+    let u = 2f32.powi(-23);
+    let dirs = [
+        Vec3::X,
+        Vec3::NEG_X,
+        Vec3::Y,
+        Vec3::NEG_Y,
+        Vec3::Z,
+        Vec3::NEG_Z,
+        vec3(0.6, 0.8, 0.0),
+        vec3(0.0, -0.6, 0.8),
+    ];
+    let mut id = 0u32;
+    for shell in [4.0f32, 4.0 + 4.0 * u, 8.0, 8.0 - 8.0 * u] {
+        for d in dirs {
+            for r in [0.0, 0.5, 1.0, 2.0, 4.0] {
+                for _ in 0..4 {
+                    let s = Sphere::new(p + d * shell, r);
+                    hi.push(i.insert(s, id).unwrap());
+                    hb.push(brute.insert(s, id).unwrap());
+                    id += 1;
+                }
+            }
+        }
+    }
+    let n = id as usize;
+    for metric in [Metric::Surface, Metric::Center] {
+        for limit in [f32::INFINITY, 4.0, 6.0] {
+            for k in [16, 17, 255, 256, 257, 300, n - 1, n, n + 1] {
+                let q = Nearest::new(p, k).metric(metric).within(limit);
+                assert_nearest_as_brute(&i, &brute, (&hi, &hb), &q);
+            }
+        }
+    }
+}
+per_index!(nearest_k_around_the_sorted_limit);
 
 // ---- sphere sweeps at extreme coordinates and radii --------------------------------
 

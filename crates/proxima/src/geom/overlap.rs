@@ -640,14 +640,30 @@ pub fn point_aabb_distance_sq(p: Vec3, b: &Aabb) -> f64 {
 /// of 1e-12 relative covers both. O(1): a few flops, no square root.
 #[inline]
 pub fn distance_exceeds(s2: f64, r: f32, d: f32) -> bool {
+    s2 > exceeds_threshold(distance_midpoint(d), r)
+}
+
+/// The midpoint `m` of [`distance_exceeds`] for the bound `d`: halfway between
+/// `d` (`-0.0` taken as `0`) and the next `f32` up, `∞` when `d` is infinite
+/// or `f32::MAX` (nothing surely exceeds those). The searches keep it beside
+/// their bound, which changes far less often than it is tested. O(1).
+#[inline]
+pub(crate) fn distance_midpoint(d: f32) -> f64 {
     if d == f32::INFINITY {
-        return false;
+        return f64::INFINITY;
     }
     // -0.0 (a limit of -0.0) is 0; `d + 1 ulp` overflows to ∞ at f32::MAX.
     let d = if d > 0.0 { d } else { 0.0 };
-    let m = (d as f64 + f32::from_bits(d.to_bits() + 1) as f64) * 0.5;
+    (d as f64 + f32::from_bits(d.to_bits() + 1) as f64) * 0.5
+}
+
+/// The squared distance above which [`distance_exceeds`] holds for a sphere
+/// of radius `r` and the midpoint `m` ([`distance_midpoint`]): `(m + r)²`
+/// with the 1e-12 relative margin; `∞` for an infinite `m`. O(1).
+#[inline]
+pub(crate) fn exceeds_threshold(m: f64, r: f32) -> f64 {
     let t = m + r as f64;
-    s2 > t * t * (1.0 + 1e-12)
+    t * t * (1.0 + 1e-12)
 }
 
 /// Ray (or segment) against a box: the interval `[t0, t1]` of `f32`s that

@@ -51,7 +51,7 @@ impl<T, S: Store> CellGrid<T, S> {
         }
         let offer = |best: &mut KBest<'_>, slot: u32| {
             let s = &self.spheres[slot as usize];
-            let Some(distance) = q.metric.distance_within(q.point, s, best.bound()) else {
+            let Some(distance) = q.metric.distance_within(q.point, s, best) else {
                 return;
             };
             if filter.map_or(true, |f| f.interacts(self.filters[slot as usize])) {

@@ -8,7 +8,7 @@
 //! it less the reach (largest gridded radius plus margin), and inside the
 //! union box of the gridded spheres: its distance is at least the point's
 //! distance to that part of the union box. Rows of a slab whose spheres are
-//! all farther than the heap's bound are skipped whole.
+//! all farther than the candidate set's bound are skipped whole.
 
 use super::UniformGrid3d;
 use crate::broad::cell_grid::keys::KeyBox;
@@ -35,7 +35,7 @@ impl<T> UniformGrid3d<T> {
         }
         let offer = |best: &mut KBest<'_>, slot: u32| {
             let s = &self.spheres[slot as usize];
-            let Some(distance) = q.metric.distance_within(q.point, s, best.bound()) else {
+            let Some(distance) = q.metric.distance_within(q.point, s, best) else {
                 return;
             };
             if filter.map_or(true, |f| f.interacts(self.filters[slot as usize])) {
@@ -87,7 +87,7 @@ impl<T> UniformGrid3d<T> {
                         if x1 > x0 {
                             let row = g.loose_block([x0, y, z], [x1, y, z]);
                             let d2 = overlap::point_aabb_distance_sq(p, &row);
-                            if overlap::distance_exceeds(d2, 0.0, best.bound()) {
+                            if best.exceeds_sq(d2) {
                                 continue;
                             }
                         }

@@ -1,5 +1,5 @@
 //! k nearest neighbours [sources: index-queries]: a depth-first branch and
-//! bound over the node regions, nearer child first, with the bounded heap of
+//! bound over the node regions, nearer child first, with the bounded candidate set of
 //! `broad/nearest.rs`.
 
 use super::node::{FixedStack, NIL};
@@ -12,7 +12,7 @@ impl<T> LooseKdTree<T> {
     /// The `k` nearest into `out`, nearest first, ties by handle.
     ///
     /// A node is skipped only if the correctly rounded distance from the point
-    /// to its region is surely above the heap's bound
+    /// to its region is surely above the candidate set's bound
     /// ([`overlap::distance_exceeds`] on [`overlap::point_aabb_distance_sq`]);
     /// the region contains every sphere of the subtree, and the rounded
     /// distances are monotone, so no object of a pruned subtree could have
@@ -34,11 +34,11 @@ impl<T> LooseKdTree<T> {
         }
         let mut stack = FixedStack::<(u32, f64)>::new();
         let d0 = overlap::point_aabb_distance_sq(q.point, &self.region(&self.nodes[self.root]));
-        if !overlap::distance_exceeds(d0, 0.0, best.bound()) {
+        if !best.exceeds_sq(d0) {
             stack.push((self.root, d0));
         }
         while let Some((n, d)) = stack.pop() {
-            if overlap::distance_exceeds(d, 0.0, best.bound()) {
+            if best.exceeds_sq(d) {
                 continue;
             }
             let node = &self.nodes[n];
@@ -46,7 +46,7 @@ impl<T> LooseKdTree<T> {
                 continue;
             }
             for (p, s) in node.range().zip(&self.store.sphere[node.range()]) {
-                if let Some(distance) = q.metric.distance_within(q.point, s, best.bound()) {
+                if let Some(distance) = q.metric.distance_within(q.point, s, &best) {
                     let (handle, of, _) = self.store.full(p);
                     if filter.map_or(true, |f| f.interacts(of)) {
                         best.offer(Neighbor { handle, distance });
@@ -58,7 +58,7 @@ impl<T> LooseKdTree<T> {
                 let c = node.child[side];
                 if c != NIL {
                     let dc = overlap::point_aabb_distance_sq(q.point, &self.region(&self.nodes[c]));
-                    if !overlap::distance_exceeds(dc, 0.0, best.bound()) {
+                    if !best.exceeds_sq(dc) {
                         *e = (c, dc);
                     }
                 }

@@ -1,5 +1,5 @@
 //! k nearest neighbours [sources: index-queries]: a depth-first branch and
-//! bound over the loose boxes, nearer octant first, with the bounded heap of
+//! bound over the loose boxes, nearer octant first, with the bounded candidate set of
 //! `broad/nearest.rs`.
 
 use super::node::NONE;
@@ -13,7 +13,7 @@ impl<T> LinearOctree<T> {
     /// The `k` nearest into `out`, nearest first, ties by handle.
     ///
     /// A subtree is skipped only if the correctly rounded distance from the
-    /// point to its loose box is surely above the heap's bound
+    /// point to its loose box is surely above the candidate set's bound
     /// ([`overlap::distance_exceeds`] on [`overlap::point_aabb_distance_sq`]):
     /// the loose box contains every sphere below it (`validate` checks it) and
     /// the rounded distances are monotone, so a pruned subtree holds nothing
@@ -49,7 +49,7 @@ impl<T> LinearOctree<T> {
         filter: Option<Filter>,
         best: &mut KBest<'_>,
     ) {
-        if overlap::distance_exceeds(dist_sq, 0.0, best.bound()) {
+        if best.exceeds_sq(dist_sq) {
             return;
         }
         let n = &self.nodes[i];
@@ -58,8 +58,7 @@ impl<T> LinearOctree<T> {
         }
         if n.leaf {
             for it in &n.items {
-                let Some(distance) = q.metric.distance_within(q.point, &it.sphere, best.bound())
-                else {
+                let Some(distance) = q.metric.distance_within(q.point, &it.sphere, best) else {
                     continue;
                 };
                 if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
@@ -80,7 +79,7 @@ impl<T> LinearOctree<T> {
             let cc = child_coords(c, k);
             let loose = self.loose_of(cc, d + 1, self.nodes[ch].max_extent);
             let dc = overlap::point_aabb_distance_sq(q.point, &loose);
-            if !overlap::distance_exceeds(dc, 0.0, best.bound()) {
+            if !best.exceeds_sq(dc) {
                 order[m] = (dc, ch, cc);
                 m += 1;
             }

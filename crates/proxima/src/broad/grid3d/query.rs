@@ -190,22 +190,21 @@ impl<T> UniformGrid3d<T> {
     /// point of the path within reach of a gridded centre is inside it);
     /// `None` when nothing is gridded.
     fn path_of<C: Cast>(&self, cast: &C) -> Option<(Path<'_>, Aabb)> {
-        if self.extent.min.cmpgt(self.extent.max).any() {
-            return None;
-        }
+        let m = self.extent_magnitude()?;
         let (ray, r) = cast.path();
         let path = Path {
             g: &self.geom,
             clip: RayClip::new(&ray),
             r,
         };
-        let m = self
-            .extent
-            .min
-            .abs()
-            .max(self.extent.max.abs())
-            .max_element();
         Some((path, self.extent.grown(path.reach(m) - self.geom.limit)))
+    }
+
+    /// The largest coordinate magnitude of the gridded spheres' bounds, or
+    /// `None` when nothing is gridded.
+    fn extent_magnitude(&self) -> Option<f32> {
+        let e = &self.extent;
+        (!e.min.cmpgt(e.max).any()).then(|| e.min.abs().max(e.max.abs()).max_element())
     }
 
     /// Whether [`UniformGrid3d::visit_cast`] can walk `cast`
@@ -213,16 +212,9 @@ impl<T> UniformGrid3d<T> {
     /// cell: the walk clips to them grown by the reach). Other casts take the
     /// exact cell-range visit.
     pub(super) fn walkable<C: Cast>(&self, cast: &C) -> bool {
-        if self.extent.min.cmpgt(self.extent.max).any() {
-            return true; // nothing gridded: the walk returns at once
-        }
-        let m = self
-            .extent
-            .min
-            .abs()
-            .max(self.extent.max.abs())
-            .max_element();
-        cast.walk_fits(m + self.geom.cell)
+        // Nothing gridded: the walk returns at once.
+        self.extent_magnitude()
+            .map_or(true, |m| cast.walk_fits(m + self.geom.cell))
     }
 
     /// Reports the gridded objects a ray or a sphere sweep touches.

@@ -187,7 +187,7 @@ impl Selection for Ray {
     }
     #[inline]
     fn selects(&self, s: &Sphere) -> bool {
-        overlap::ray_sphere(self, s).is_some()
+        overlap::ray_touches_sphere(self, s)
     }
     #[inline]
     fn classify_box(&self, b: &Aabb, mask: u8) -> (Relation, u8) {
@@ -226,7 +226,7 @@ impl Selection for SphereSweep {
     }
     #[inline]
     fn selects(&self, s: &Sphere) -> bool {
-        overlap::sweep_sphere(self, s).is_some()
+        overlap::sweep_touches_sphere(self, s)
     }
     #[inline]
     fn classify_box(&self, b: &Aabb, mask: u8) -> (Relation, u8) {

@@ -109,6 +109,24 @@ pub(crate) trait Cast: Selection {
     /// the ray rounds but the exact tests do not). The grids' segment walks
     /// follow it, widened by the reach, conservatively.
     fn path(&self) -> (Ray, f32);
+
+    /// Whether the grids' segment walks can follow this cast's path
+    /// ([`Cast::path`]) over a region whose coordinates (plus the grid's own
+    /// padding) are at most `m` in magnitude: the path's origin, its length
+    /// up to `t = 1`, its reach and `m` add up to less than 2^-4 of
+    /// `f32::MAX`, so that every padded coordinate and bound of the walk
+    /// stays finite. A sweep or region near `f32::MAX` (ops proptest: a sweep
+    /// from x = 3.4e38 to -2.1e36 padded to infinity and missed a hit; a
+    /// radius near `f32::MAX` made the clip meet `∞ - ∞`) fails it, and so
+    /// does a NaN; the grids then visit the cells of the cast's bounds
+    /// instead, exact at any magnitude. The one guard of both grids' walks.
+    #[inline]
+    fn walk_fits(&self, m: f32) -> bool {
+        const SAFE: f32 = f32::MAX / 16.0;
+        let (ray, r) = self.path();
+        let len = ray.dir.abs().max_element() * ray.max_t.min(1.0);
+        ray.origin.abs().max_element() + len + r + m < SAFE
+    }
 }
 
 impl Cast for Ray {

@@ -97,6 +97,50 @@ pub(super) trait Line {
     /// later than the returned parameter (front-to-back pruning stays
     /// consistent).
     fn entry_floor(&self) -> f32;
+    /// A cheap upper bound on [`Line::entry_floor`] ([`entry_ceiling`]):
+    /// when the rounded parameter is at least this, clamping it by the entry
+    /// floor cannot change it, and the box test is skipped.
+    fn entry_ceiling(&self) -> f64;
+}
+
+/// 2^-50 = 8u: the relative widening of [`entry_ceiling`].
+const CEIL_WIDEN: f64 = 1.0 / 1_125_899_906_842_624.0;
+
+/// An upper bound on the exact parameter at which the ray from `o` along `d`
+/// (the `f32` ray of the shape's box test) enters the exact box of the ball
+/// of radius `rho` around `c` (`max(0, largest near-slab parameter)`); so
+/// an upper bound on the box test's entry bound of any box containing that
+/// box (its slabs are wider on every axis, so each near parameter is no
+/// larger, and the box test rounds down and clamps at 0; a missed box gives
+/// 0). An axis with `d = 0` has no near parameter.
+///
+/// Why it is one (u = 2^-53): `c - o ∓ ρ` in `f64` (the `f32` inputs, `ρ`
+/// within `u ρ`) is within `4.1u M` of its value, `M = |c| + |o| + ρ`; it is
+/// moved by `8u M` towards making the quotient larger (adding that rounds
+/// once more, `1.01u M`), then divided by `d` (`u` relative) and the
+/// largest quotient (or 0) multiplied by `1 + 8u`. No `f32` input
+/// overflows or underflows these `f64` operations. Cost: 3 divisions.
+#[inline]
+pub(super) fn entry_ceiling(o: [f32; 3], d: [f32; 3], c: [f32; 3], rho: f64) -> f64 {
+    let mut t = 0.0f64;
+    for i in 0..3 {
+        let di = d[i] as f64;
+        if di == 0.0 {
+            continue;
+        }
+        let co = c[i] as f64 - o[i] as f64;
+        let slack = (c[i].abs() as f64 + o[i].abs() as f64 + rho) * CEIL_WIDEN;
+        // The near face is `c - ρ` moving up, `c + ρ` moving down.
+        let q = if di > 0.0 {
+            (co - rho + slack) / di
+        } else {
+            (co + rho - slack) / di
+        };
+        if q > t {
+            t = q;
+        }
+    }
+    t * (1.0 + CEIL_WIDEN)
 }
 
 /// The exact `m`, `d`, `ρ` and `T` of a [`Line`], and the signs its filters may
@@ -165,15 +209,33 @@ impl Exact {
     }
 }
 
-/// The smallest parameter `t` in `[0, T]` at which the point is (up to the
-/// rounding of the returned value) within `ρ` of the centre, or `None` when it
-/// never is. Hit or miss is exact (see the module); `t` is the closest-approach
-/// formula in `f64` (no `b² - ac` cancellation), rounded to `f32`, then clamped
-/// into `[entry_floor, T]`. Cost: ~40 flops, plus expansions for near-ties.
+/// Whether the moving point comes within `ρ` ([`first_touch`]'s exact
+/// decision, without the parameter: the selections need only this, and
+/// skipping the parameter saves the entry bound's box test).
 #[inline]
-pub(super) fn first_touch<L: Line>(l: &L) -> Option<f32> {
+pub(super) fn touches<L: Line>(l: &L) -> bool {
+    touch(l).is_some()
+}
+
+/// How [`touch`] found the point to come within `ρ`.
+enum Touch {
+    /// At `t = 0`.
+    Inside,
+    /// Later, approaching: `m`, `d`, `b = m·d` and `a = |d|²` in `f64`.
+    Approach {
+        m: [f64; 3],
+        d: [f64; 3],
+        b: f64,
+        a: f64,
+    },
+}
+
+/// The exact decision shared by [`first_touch`] and [`touches`]: `None`
+/// when the point never comes within `ρ` in `[0, T]`.
+#[inline]
+fn touch<L: Line>(l: &L) -> Option<Touch> {
     if l.starts_inside() {
-        return Some(0.0);
+        return Some(Touch::Inside);
     }
     let (m, d) = l.m_d();
     let (b, b_perm) = (dot(m, d), dot(m.map(f64::abs), d.map(f64::abs)));
@@ -199,12 +261,30 @@ pub(super) fn first_touch<L: Line>(l: &L) -> Option<f32> {
         let (p, err) = l.end(m, d);
         square_gap(rho2, units, p, err).unwrap_or_else(|| l.exact().end_gap()) != Ordering::Less
     };
-    if !hit {
-        return None;
-    }
+    hit.then_some(Touch::Approach { m, d, b, a })
+}
+
+/// The smallest parameter `t` in `[0, T]` at which the point is (up to the
+/// rounding of the returned value) within `ρ` of the centre, or `None` when it
+/// never is. Hit or miss is exact (see the module); `t` is the closest-approach
+/// formula in `f64` (no `b² - ac` cancellation), rounded to `f32`, then clamped
+/// into `[entry_floor, T]`. Cost: ~40 flops, plus expansions for near-ties.
+#[inline]
+pub(super) fn first_touch<L: Line>(l: &L) -> Option<f32> {
+    let (m, d, b, a) = match touch(l)? {
+        Touch::Inside => return Some(0.0),
+        Touch::Approach { m, d, b, a } => (m, d, b, a),
+    };
+    let rho2 = l.rho2();
     let tc = -b / a;
     let closest = [m[0] + d[0] * tc, m[1] + d[1] * tc, m[2] + d[2] * tc];
     let h2 = (rho2 - dot(closest, closest)).max(0.0);
     let t = (tc - (h2 / a).sqrt()).max(0.0) as f32;
-    Some(t.max(l.entry_floor()).min(l.t_max()))
+    // `t >= ceiling >= floor`: the clamp would keep `t`; skip its box test.
+    let t = if t as f64 >= l.entry_ceiling() {
+        t
+    } else {
+        t.max(l.entry_floor())
+    };
+    Some(t.min(l.t_max()))
 }

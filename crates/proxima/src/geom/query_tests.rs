@@ -531,3 +531,255 @@ fn sweep_miss_pretest_is_conservative() {
         "{clear_rejected} of {clear}"
     );
 }
+
+/// Exactly: is `c` below (`below`) or above the real number `o + d t`?
+fn on_side(c: f64, o: f64, d: f64, t: f64, below: bool) -> bool {
+    let v = Exp::of(o).add(&Exp::of(d).mul(&Exp::of(t)));
+    let s = v.sub(&Exp::of(c)).sign();
+    s == if below {
+        Ordering::Greater
+    } else {
+        Ordering::Less
+    } || s == Ordering::Equal
+}
+
+/// Exactly: is the ray's parameter interval inside `b` (within `[0, max_t]`)
+/// empty? Some entry parameter (or 0) exceeds some exit parameter (or
+/// `max_t`), compared as exact fractions `(x - o) / d`; or a zero direction
+/// component lies outside its slab.
+fn exactly_empty(ray: &Ray, b: &Aabb) -> bool {
+    // (numerator, denominator) of each finite entry and exit parameter.
+    let mut enter = vec![(Exp::of(0.0), 1.0f64)];
+    let mut exit = Vec::new();
+    let mut inf_entry = false;
+    if ray.max_t.is_finite() {
+        exit.push((Exp::of(ray.max_t as f64), 1.0f64));
+    }
+    for a in 0..3 {
+        let (o, d) = (ray.origin[a] as f64, ray.dir[a] as f64);
+        let (lo, hi) = (b.min[a] as f64, b.max[a] as f64);
+        if d == 0.0 {
+            if o < lo || o > hi {
+                return true;
+            }
+            continue;
+        }
+        let (near, far) = if d > 0.0 { (lo, hi) } else { (hi, lo) };
+        if near.is_finite() {
+            enter.push((Exp::diff(near, o), d));
+        } else if (near - o) / d == f64::INFINITY {
+            inf_entry = true; // a side at ∓∞ entered only at t = ∞
+        }
+        if far.is_finite() {
+            exit.push((Exp::diff(far, o), d));
+        }
+    }
+    // n1 / d1 > n2 / d2  <=>  (n1 d2 - n2 d1) has the sign of d1 d2.
+    (inf_entry && !exit.is_empty())
+        || enter.iter().any(|(n1, d1)| {
+            exit.iter().any(|(n2, d2)| {
+                let v = n1.mul(&Exp::of(*d2)).sub(&n2.mul(&Exp::of(*d1)));
+                let want = if d1 * d2 > 0.0 {
+                    Ordering::Greater
+                } else {
+                    Ordering::Less
+                };
+                v.sign() == want
+            })
+        })
+}
+
+/// `RayClip` (the grids' path clip) is conservative against exact
+/// arithmetic on adversarial rays and boxes: coarse coordinates with exact
+/// ties, magnitudes from 1e-20 to 1e30, zero direction components, boxes
+/// with infinite or degenerate sides and boxes the ray only grazes. It
+/// fails only when the exact interval is empty (`ray_aabb` says so, or
+/// expansions do where `ray_aabb` rounds a tiny exit up to -0); its `t0`
+/// rounded down is at most `ray_aabb`'s floor of the exact entry and its
+/// `t1` at least the exact exit (checked with expansions), and its
+/// coordinate range holds the exact coordinates at both ends.
+#[test]
+fn ray_clip_contains_the_exact_interval() {
+    let mut rng = Pcg64::seed_from_u64(41);
+    let (mut met, mut grazed) = (0, 0);
+    for k in 0..200_000 {
+        let o = cv(&mut rng);
+        let mut d = cv(&mut rng);
+        if k % 4 == 0 {
+            d[rng.gen_range(0..3)] = 0.0;
+        }
+        if d == Vec3::ZERO {
+            d = Vec3::X;
+        }
+        let max_t = [f32::INFINITY, 1.0, coarse(&mut rng).abs()][k % 3];
+        let ray = Ray::with_max_t(o, d, max_t);
+        let (mut lo, mut hi) = (cv(&mut rng), cv(&mut rng));
+        for a in 0..3 {
+            if lo[a] > hi[a] {
+                std::mem::swap(&mut lo[a], &mut hi[a]);
+            }
+            match rng.gen_range(0..8) {
+                0 => lo[a] = f32::NEG_INFINITY,
+                1 => hi[a] = f32::INFINITY,
+                2 => hi[a] = lo[a],
+                _ => {}
+            }
+        }
+        if k % 5 == 0 {
+            // A box touching the ray at one parameter: its corner on it.
+            let t = coarse(&mut rng).abs();
+            let p = o + d * t;
+            (lo, hi) = (p, p + cv(&mut rng).abs());
+        }
+        let b = Aabb::new(lo, hi);
+        let exact = ray_aabb(&ray, &b);
+        let clip = RayClip::new(&ray);
+        let Some((c0, c1)) = clip.clip(&b) else {
+            // `ray_aabb` rounds outward, so it may meet a box the ray misses
+            // by less than an `f32` step of the parameter: decide exactly.
+            assert!(
+                exact.is_none() || exactly_empty(&ray, &b),
+                "{ray:?} {b:?}: clip misses, ray_aabb {exact:?}"
+            );
+            continue;
+        };
+        let Some((t0, t1)) = exact else { continue };
+        met += 1;
+        grazed += (t0 == t1) as u32;
+        assert!(
+            exact::round_down_f32(c0) <= t0,
+            "{ray:?} {b:?}: {c0} > {t0}"
+        );
+        // The exact exit is min(max_t, exits): c1 is at or past one of them.
+        let mut past_exit = c1 >= max_t as f64 || !c1.is_finite();
+        // The exact entry is max(0, entries): c0 is at or before one of them.
+        let mut before_entry = c0 <= 0.0;
+        for a in 0..3 {
+            let (o, d) = (o[a] as f64, d[a] as f64);
+            if d == 0.0 {
+                continue;
+            }
+            let (near, far) = if d > 0.0 {
+                (lo[a], hi[a])
+            } else {
+                (hi[a], lo[a])
+            };
+            if near.is_finite() {
+                // c0 <= (near - o) / d  <=>  o + d c0 on the near side of `near`.
+                before_entry |= on_side(near as f64, o, d, c0, d < 0.0);
+            } else if (near as f64 - o) / d == f64::INFINITY {
+                before_entry = true; // entered only at t = ∞ (a side at ∓∞)
+            }
+            if far.is_finite() && c1.is_finite() {
+                past_exit |= on_side(far as f64, o, d, c1, d > 0.0);
+            }
+        }
+        assert!(before_entry && past_exit, "{ray:?} {b:?}: [{c0}, {c1}]");
+        for a in 0..3 {
+            let (plo, phi) = clip.coord_range(a, c0, c1);
+            for t in [c0, c1] {
+                if t.is_finite() {
+                    let (o, d) = (o[a] as f64, d[a] as f64);
+                    let ok_lo = plo == f64::NEG_INFINITY || on_side(plo, o, d, t, true);
+                    let ok_hi = phi == f64::INFINITY || on_side(phi, o, d, t, false);
+                    assert!(
+                        ok_lo && ok_hi,
+                        "{ray:?} {b:?} axis {a}: [{plo}, {phi}] at {t}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(met > 20_000 && grazed > 500, "{met} {grazed}");
+}
+
+/// The selections' exact tests without the parameter agree with the tests
+/// that return it, on the adversarial sweeps and rays of the other tests
+/// (coarse coordinates with exact ties, every magnitude, grazes at relative
+/// distances down to 1e-7) and with the independent exact reference.
+#[test]
+fn touch_tests_agree_with_first_contact() {
+    let mut rng = Pcg64::seed_from_u64(43);
+    let mut touched = 0;
+    for k in 0..100_000 {
+        let c = cv(&mut rng);
+        let (r, rr) = (coarse(&mut rng).abs(), coarse(&mut rng).abs());
+        let from = cv(&mut rng);
+        let to = if k % 3 == 0 {
+            // Tangent: end on the sphere's surface along an axis.
+            let mut t = c;
+            t[k % 3] += r + rr;
+            t
+        } else {
+            cv(&mut rng)
+        };
+        let sw = SphereSweep::new(from, to, rr);
+        let s = Sphere::new(c, r);
+        if sw.validate().is_err() || s.validate().is_err() {
+            continue;
+        }
+        let t = sweep_touches_sphere(&sw, &s);
+        assert_eq!(t, sweep_sphere(&sw, &s).is_some(), "{sw:?} {s:?}");
+        assert_eq!(t, sweep_touches_exact(&sw, &s), "{sw:?} {s:?}");
+        touched += t as u32;
+        let d = to - from;
+        if d != Vec3::ZERO && d.is_finite() {
+            let ray = Ray::with_max_t(from, d, [1.0, f32::INFINITY][k % 2]);
+            assert_eq!(
+                ray_touches_sphere(&ray, &s),
+                ray_sphere(&ray, &s).is_some(),
+                "{ray:?} {s:?}"
+            );
+        }
+    }
+    assert!(touched > 10_000, "{touched}");
+}
+
+/// `entry_ceiling` bounds `entry_floor` from above on adversarial sweeps and
+/// rays (coarse coordinates with exact ties, magnitudes from 1e-20 to 1e30,
+/// zero components, starts inside, grazes, overflowing directions), so the
+/// skipped clamp of the contact parameter never changes it (and the skip
+/// is taken for most hits).
+#[test]
+fn entry_ceiling_bounds_the_entry_floor() {
+    let mut rng = Pcg64::seed_from_u64(47);
+    let mut skipped = 0;
+    for k in 0..200_000 {
+        let c = cv(&mut rng);
+        let (r, rr) = (coarse(&mut rng).abs(), coarse(&mut rng).abs());
+        let from = cv(&mut rng);
+        let mut to = match k % 4 {
+            0 => {
+                let mut t = c;
+                t[k % 3] += r + rr;
+                t
+            }
+            1 => from,
+            _ => cv(&mut rng),
+        };
+        if k % 7 == 0 {
+            to[k % 3] = 0.0;
+        }
+        if k % 1000 == 0 {
+            to.x = f32::MAX;
+        }
+        let (sw, s) = (SphereSweep::new(from, to, rr), Sphere::new(c, r));
+        if sw.validate().is_err() || s.validate().is_err() {
+            continue;
+        }
+        let l = SweepBall { sweep: &sw, s: &s };
+        let (ceil, floor) = (l.entry_ceiling(), l.entry_floor());
+        assert!(ceil >= floor as f64, "{sw:?} {s:?}: {ceil} < {floor}");
+        if let Some(t) = sweep_sphere(&sw, &s) {
+            skipped += (t as f64 >= ceil) as u32;
+        }
+        let d = to - from;
+        if d != Vec3::ZERO && d.is_finite() {
+            let ray = Ray::with_max_t(from, d, [1.0, f32::INFINITY][k % 2]);
+            let l = RayBall { ray: &ray, s: &s };
+            let (ceil, floor) = (l.entry_ceiling(), l.entry_floor());
+            assert!(ceil >= floor as f64, "{ray:?} {s:?}: {ceil} < {floor}");
+        }
+    }
+    assert!(skipped > 10_000, "{skipped}");
+}

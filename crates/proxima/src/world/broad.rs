@@ -147,9 +147,9 @@ impl Broad {
             let hit = match query {
                 Query::Sphere(q) => overlap::sphere_sphere(q, s),
                 Query::Aabb(b) => overlap::sphere_aabb(s, b),
-                Query::Ray(r) => overlap::ray_sphere(r, s).is_some(),
+                Query::Ray(r) => overlap::ray_touches_sphere(r, s),
                 Query::Frustum(fr) => overlap::frustum_sphere(fr, s) != Relation::Outside,
-                Query::Sweep(sw) => overlap::sweep_sphere(sw, s).is_some(),
+                Query::Sweep(sw) => overlap::sweep_touches_sphere(sw, s),
             };
             if hit {
                 f(h.index());

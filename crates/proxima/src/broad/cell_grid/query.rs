@@ -38,6 +38,7 @@ use super::keys::{Key, KeyBox};
 use super::list::{CellEntry, Packed};
 use super::store::{Store, Within};
 use super::CellGrid;
+use crate::broad::walk::Cast;
 use crate::broad::Selection;
 use crate::geom::{Aabb, Frustum, Relation, Sphere, SphereSweep};
 use crate::Handle;
@@ -95,23 +96,12 @@ impl<T, S: Store> CellGrid<T, S> {
     }
 
     /// True if `sweep` takes the cell walk along its segment (`ray.rs`):
-    /// it is not [short](Self::sweep_is_short), and its coordinates, length
-    /// and radius are far enough below `f32::MAX` that the walk's padded
-    /// coordinates stay finite (ops proptest: a sweep from x = 3.4e38 to
-    /// -2.1e36 padded them to infinity and missed a hit). Other sweeps visit
-    /// the cells of their bounds, exact at any magnitude.
+    /// it is not [short](Self::sweep_is_short), and the walk can follow it
+    /// ([`Cast::walk_fits`]: its padded coordinates stay finite). Other
+    /// sweeps visit the cells of their bounds, exact at any magnitude.
     #[inline]
     pub fn sweep_walks(&self, sweep: &SphereSweep) -> bool {
-        // 2^-4 of f32::MAX leaves room for the walk's sums of coordinates,
-        // lengths and pads.
-        const SAFE: f32 = f32::MAX / 16.0;
-        let m = sweep
-            .from
-            .abs()
-            .max(sweep.to.abs())
-            .max((sweep.to - sweep.from).abs())
-            .max_element();
-        m + sweep.radius < SAFE && !self.sweep_is_short(sweep)
+        sweep.walk_fits(0.0) && !self.sweep_is_short(sweep)
     }
 
     /// True if an object with lowest key `lo` is reported from `key` by a query

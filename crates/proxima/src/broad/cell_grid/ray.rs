@@ -388,7 +388,7 @@ impl<T, S: Store> CellGrid<T, S> {
         self.walk_ray(cast, |s| match s {
             Step::Candidate(e) => {
                 let s = &self.spheres[e.slot as usize];
-                if cast.contact(s).is_some() {
+                if cast.selects(s) {
                     let (h, v) = self.resolve(e.slot);
                     f(h, s, v)
                 } else {

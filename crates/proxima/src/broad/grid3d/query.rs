@@ -5,7 +5,9 @@ use super::cells::Geometry;
 use super::UniformGrid3d;
 use crate::broad::walk::Cast;
 use crate::broad::{Filter, RayHit, Selection};
-use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere};
+use crate::geom::exact::round_down_f32;
+use crate::geom::overlap::RayClip;
+use crate::geom::{Aabb, Frustum, Relation, Sphere};
 use crate::Handle;
 use std::ops::ControlFlow;
 
@@ -41,7 +43,7 @@ impl<T> UniformGrid3d<T> {
         }
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
-                self.visit_row(q, [lo[0], y, z], hi[0], Frustum::ALL_PLANES, f)?;
+                self.visit_row::<Q, true>(q, [lo[0], y, z], hi[0], Frustum::ALL_PLANES, f)?;
             }
         }
         ControlFlow::Continue(())
@@ -80,7 +82,7 @@ impl<T> UniformGrid3d<T> {
             Relation::Intersecting if block_cells(lo, hi) <= LEAF_CELLS => {
                 for z in lo[2]..=hi[2] {
                     for y in lo[1]..=hi[1] {
-                        self.visit_row(q, [lo[0], y, z], hi[0], mask, f)?;
+                        self.visit_row::<Q, true>(q, [lo[0], y, z], hi[0], mask, f)?;
                     }
                 }
                 ControlFlow::Continue(())
@@ -120,11 +122,15 @@ impl<T> UniformGrid3d<T> {
         ControlFlow::Continue(())
     }
 
-    /// The cells `start.x ..= x1` of one row. Cells holding several objects are
-    /// first classified by their centres and loose box over the planes in `mask` (those that
-    /// may still cut them): `Outside` skips them, `Inside` reports without exact
-    /// tests.
-    fn visit_row<Q: Selection + ?Sized>(
+    /// The cells `start.x ..= x1` of one row. With `CLASSIFY`, cells holding
+    /// several objects are first classified by their centres and loose box
+    /// over the planes in `mask` (those that may still cut them): `Outside`
+    /// skips them, `Inside` reports without exact tests. Without it (the cast
+    /// walks, whose rows are already clipped to the path) every object is
+    /// tested exactly.
+    // Always inlined: the loop of the cast walk and of the small-range scan.
+    #[inline(always)]
+    fn visit_row<Q: Selection + ?Sized, const CLASSIFY: bool>(
         &self,
         q: &Q,
         start: [u32; 3],
@@ -139,7 +145,7 @@ impl<T> UniformGrid3d<T> {
                 continue;
             }
             let mut rel = Relation::Intersecting;
-            if n > 2 {
+            if CLASSIFY && n > 2 {
                 let c = [x, start[1], start[2]];
                 let g = &self.geom;
                 rel = q
@@ -184,42 +190,31 @@ impl<T> UniformGrid3d<T> {
     /// point of the path within reach of a gridded centre is inside it);
     /// `None` when nothing is gridded.
     fn path_of<C: Cast>(&self, cast: &C) -> Option<(Path<'_>, Aabb)> {
-        if self.extent.min.cmpgt(self.extent.max).any() {
-            return None;
-        }
+        let m = self.extent_magnitude()?;
         let (ray, r) = cast.path();
         let path = Path {
             g: &self.geom,
-            ray,
+            clip: RayClip::new(&ray),
             r,
         };
-        let m = self
-            .extent
-            .min
-            .abs()
-            .max(self.extent.max.abs())
-            .max_element();
         Some((path, self.extent.grown(path.reach(m) - self.geom.limit)))
     }
 
-    /// Whether [`UniformGrid3d::visit_cast`] can walk `cast`: its reach and
-    /// the grown bounds are finite. A sweep of a radius near `f32::MAX` makes
-    /// them infinite and the exact clipping then meets `inf - inf` (NaN), on
-    /// which it would not terminate (ops proptest); such casts take the
-    /// exact cell-range visit instead.
+    /// The largest coordinate magnitude of the gridded spheres' bounds, or
+    /// `None` when nothing is gridded.
+    fn extent_magnitude(&self) -> Option<f32> {
+        let e = &self.extent;
+        (!e.min.cmpgt(e.max).any()).then(|| e.min.abs().max(e.max.abs()).max_element())
+    }
+
+    /// Whether [`UniformGrid3d::visit_cast`] can walk `cast`
+    /// ([`Cast::walk_fits`] over the gridded spheres' bounds, padded by a
+    /// cell: the walk clips to them grown by the reach). Other casts take the
+    /// exact cell-range visit.
     pub(super) fn walkable<C: Cast>(&self, cast: &C) -> bool {
-        match self.path_of(cast) {
-            None => true,
-            Some((path, ext)) => {
-                path.ray.origin.is_finite()
-                    && path.ray.dir.is_finite()
-                    && path
-                        .reach(ext.min.abs().max(ext.max.abs()).max_element())
-                        .is_finite()
-                    && ext.min.is_finite()
-                    && ext.max.is_finite()
-            }
-        }
+        // Nothing gridded: the walk returns at once.
+        self.extent_magnitude()
+            .map_or(true, |m| cast.walk_fits(m + self.geom.cell))
     }
 
     /// Reports the gridded objects a ray or a sphere sweep touches.
@@ -254,16 +249,12 @@ impl<T> UniformGrid3d<T> {
                 let Some((x0, x1, _)) = path.span(&path.restrict(&bk, 1, j), 0) else {
                     continue;
                 };
-                // No cell box test here (unlike `visit_row`): the path meets
-                // every cell's centres widened by the reach by construction,
-                // and a cast never classifies a box `Inside`, so that test
-                // could only skip a cell the exact tests reject anyway.
-                let first = g.index([g.coord(x0, 0), j, k]);
-                for c in first..=first + (g.coord(x1, 0) - g.coord(x0, 0)) {
-                    if self.store.count(c) > 0 {
-                        self.test_cell(cast, c, Relation::Intersecting, Frustum::ALL_PLANES, f)?;
-                    }
-                }
+                // No cell classification (`CLASSIFY = false`): the path
+                // meets every cell's centres widened by the reach by
+                // construction, and a cast never classifies a box `Inside`,
+                // so it could only skip a cell the exact tests reject anyway.
+                let (x0, x1) = (g.coord(x0, 0), g.coord(x1, 0));
+                self.visit_row::<C, false>(cast, [x0, j, k], x1, Frustum::ALL_PLANES, f)?;
             }
         }
         ControlFlow::Continue(())
@@ -275,8 +266,9 @@ impl<T> UniformGrid3d<T> {
     /// dominant axis in its direction of travel, stopping before a slab whose
     /// reach the path enters after the best contact so far. Every object of
     /// that slab and those beyond has its centre there, so the path comes
-    /// within both radii of it only after that entry (the entry rounded down
-    /// by [`overlap::ray_aabb`]): the answer is the scan's.
+    /// within both radii of it only after that entry (bounded below by
+    /// [`Path::span`], at most the entry bound of each such sphere's box):
+    /// the answer is the scan's.
     pub(super) fn first_cast<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
         let offer = |best: &mut Option<RayHit>, slot: u32| {
@@ -292,17 +284,17 @@ impl<T> UniformGrid3d<T> {
         }
         if let Some((path, ext)) = self.path_of(cast) {
             let g = &self.geom;
-            let ad = path.ray.dir.abs();
-            let (a, b, c) = if ad.x >= ad.y && ad.x >= ad.z {
+            let ad = path.clip.d.map(f64::abs);
+            let (a, b, c) = if ad[0] >= ad[1] && ad[0] >= ad[2] {
                 (0, 1, 2)
-            } else if ad.y >= ad.z {
+            } else if ad[1] >= ad[2] {
                 (1, 2, 0)
             } else {
                 (2, 0, 1)
             };
             if let Some((a0, a1, _)) = path.span(&ext, a) {
                 let (k0, k1) = (g.coord(a0, a), g.coord(a1, a));
-                let back = path.ray.dir[a] < 0.0;
+                let back = path.clip.d[a] < 0.0;
                 for i in 0..=k1 - k0 {
                     let k = if back { k1 - i } else { k0 + i };
                     let bk = path.restrict(&ext, a, k);
@@ -338,7 +330,8 @@ impl<T> UniformGrid3d<T> {
 #[derive(Clone, Copy)]
 struct Path<'a> {
     g: &'a Geometry,
-    ray: Ray,
+    /// The centre's ray, prepared for the many clips of one walk.
+    clip: RayClip,
     r: f32,
 }
 
@@ -351,26 +344,32 @@ impl Path<'_> {
     }
 
     /// The range of the path's coordinate on axis `a` inside `b`, widened by
-    /// the reach, and the parameter at which the path enters `b` (rounded
-    /// down); `None` if it misses `b`.
+    /// the reach, and a lower bound on the parameter at which the path enters
+    /// `b` (an `f32`, rounded down); `None` if it misses `b`. The clip is
+    /// conservative ([`RayClip::clip`]: it contains the exact parameter
+    /// interval, and the coordinate range the exact one), so every cell the
+    /// exact clip would visit is visited; the entry bound is at most the
+    /// `f32` floor of the exact entry, which is at most the entry bound of
+    /// every sphere's box inside `b` ([`ray_aabb`](crate::geom::overlap::ray_aabb) is that floor and
+    /// monotone), so the front-to-back stop of [`UniformGrid3d::first_cast`]
+    /// stays exact. Cost: no division (the inverse direction is computed once
+    /// per walk, in [`UniformGrid3d::path_of`]).
     #[inline]
     fn span(&self, b: &Aabb, a: usize) -> Option<(f32, f32, f32)> {
-        let ray = &self.ray;
-        let (t0, t1) = overlap::ray_aabb(ray, b)?;
-        let p0 = ray.origin[a] as f64 + ray.dir[a] as f64 * t0 as f64;
-        let p1 = ray.origin[a] as f64 + ray.dir[a] as f64 * t1 as f64;
-        let (lo, hi) = (p0.min(p1) as f32, p0.max(p1) as f32);
-        Some((lo - self.reach(lo), hi + self.reach(hi), t0))
+        let (t0, t1) = self.clip.clip(b)?;
+        let (lo, hi) = self.clip.coord_range(a, t0, t1);
+        let (lo, hi) = (round_down_f32(lo), -round_down_f32(-hi));
+        Some((lo - self.reach(lo), hi + self.reach(hi), round_down_f32(t0)))
     }
 
     /// `b` restricted on axis `a` to the reach of slab `k`.
     #[inline]
     fn restrict(&self, b: &Aabb, a: usize, k: u32) -> Aabb {
         let (lo, hi) = self.g.slab(k, a);
-        let mut rb = *b;
-        rb.min[a] = rb.min[a].max(lo - self.reach(lo));
-        rb.max[a] = rb.max[a].min(hi + self.reach(hi));
-        rb
+        let (mut mn, mut mx) = (b.min.to_array(), b.max.to_array());
+        mn[a] = mn[a].max(lo - self.reach(lo));
+        mx[a] = mx[a].min(hi + self.reach(hi));
+        Aabb::new(mn.into(), mx.into())
     }
 }
 
@@ -606,6 +605,82 @@ mod tests {
             ig.sort_unstable();
             hb.sort_unstable();
             assert_eq!(ig, hb);
+        }
+    }
+
+    /// The cast walks' fast clipping against brute force (bit-identical hits,
+    /// times and first hits) on adversarial sweeps and rays: axis-parallel
+    /// and with zero components, along cell lines, exactly tangent to stored
+    /// spheres (grazes the exact test decides), tiny and zero radii, near and
+    /// far from the origin (1e6, where the grid's rounding margin matters),
+    /// and beyond the walk's guard (`Cast::walk_fits`).
+    #[test]
+    fn cast_walks_match_brute_force_on_adversarial_casts() {
+        use crate::broad::test_util::check_knn_sweep;
+        use crate::broad::walk::Cast;
+        use crate::geom::SphereSweep;
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(17);
+        for offset in [0.0f32, -16.0, 1e6] {
+            let base = Vec3::splat(offset);
+            let w = Aabb::new(base, base + Vec3::splat(24.0));
+            let mut g = UniformGrid3d::with_config(Grid3dConfig {
+                world: w,
+                cell_size: 2.0,
+            })
+            .unwrap();
+            let mut b = BruteForce::new();
+            let mut spheres = Vec::new();
+            for i in 0..500u32 {
+                // Centres on a coarse lattice (cell lines, exact ties) or anywhere.
+                let c = if i % 2 == 0 {
+                    base + vec3(
+                        rng.gen_range(-2..26) as f32,
+                        rng.gen_range(-2..26) as f32,
+                        rng.gen_range(-2..26) as f32,
+                    )
+                } else {
+                    base + rand_vec(&mut rng, -2.0, 26.0)
+                };
+                let r = [0.0, 0.5, 0.98, 1e-6][i as usize % 4];
+                let s = Sphere::new(c, r);
+                g.insert(s, i).unwrap();
+                b.insert(s, i).unwrap();
+                spheres.push(s);
+            }
+            for k in 0..400 {
+                let axis = k % 3;
+                let mut dir = Vec3::ZERO;
+                dir[axis] = if k % 2 == 0 { 1.0 } else { -1.0 };
+                if k % 5 == 1 {
+                    dir[(axis + 1) % 3] = rng.gen_range(-1.0..1.0);
+                }
+                let radius = [0.0, 1e-7, 0.25, 1.0, 3.0][k % 5];
+                let len = [0.0, 0.5, 3.0, 30.0][k / 5 % 4];
+                let from = match k % 4 {
+                    // Tangent to a stored sphere: moving along `axis`, offset
+                    // on the next axis by exactly both radii.
+                    0 | 1 => {
+                        let s = spheres[rng.gen_range(0..spheres.len())];
+                        let mut p = s.center - dir * (len * 0.5);
+                        p[(axis + 1) % 3] += s.radius + radius;
+                        p
+                    }
+                    // On a cell line.
+                    2 => base + (rand_vec(&mut rng, 0.0, 12.0) * 2.0).floor() * 2.0 / 2.0,
+                    _ => base + rand_vec(&mut rng, -4.0, 28.0),
+                };
+                let sw = SphereSweep::new(from, from + dir * len, radius);
+                assert!(g.walkable(&sw), "{sw:?}");
+                check_knn_sweep(&g, &b, from, 3, &sw);
+                if dir != Vec3::ZERO {
+                    let t = if k % 2 == 0 { len } else { f32::INFINITY };
+                    check_ray(&g, &b, &Ray::with_max_t(from, dir, t));
+                }
+            }
+            // Beyond the guard: the exact cell-range visit answers.
+            let far = SphereSweep::new(base, base + Vec3::X, f32::MAX / 8.0);
+            assert!(!far.walk_fits(0.0) && !g.walkable(&far));
+            check_knn_sweep(&g, &b, base, 3, &far);
         }
     }
 

@@ -70,37 +70,14 @@ impl Proxima {
     }
 }
 
-/// Spreads the low 10 bits of `v` to every third bit.
-fn spread(v: u32) -> u64 {
-    let mut x = (v & 0x3ff) as u64;
-    x = (x | (x << 16)) & 0x0300_00ff;
-    x = (x | (x << 8)) & 0x0300_f00f;
-    x = (x | (x << 4)) & 0x030c_30c3;
-    (x | (x << 2)) & 0x0924_9249
-}
-
-/// The sphere indices sorted by the Morton (Z-order) code of their centres on a
-/// 1024³ grid over the centres' box: the order a static set is bulk-loaded into
-/// an incremental index, so that nodes and object lists created one after the
-/// other are neighbours in space as well as in memory (the peers' bulk builds
-/// sort spatially too).
+/// The sphere indices sorted by the Morton (Z-order) code of their centres
+/// ([`proxima::broad::morton_order`]): the order a static set is bulk-loaded
+/// into an incremental index, so that nodes and object lists created one after
+/// the other are neighbours in space as well as in memory (the peers' bulk
+/// builds sort spatially too).
 pub fn morton_order(spheres: &[Sphere]) -> Vec<u32> {
-    let (mut lo, mut hi) = (
-        proxima::glam::Vec3::splat(f32::MAX),
-        proxima::glam::Vec3::splat(f32::MIN),
-    );
-    for s in spheres {
-        lo = lo.min(s.center);
-        hi = hi.max(s.center);
-    }
-    let scale = 1023.0 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
-    let code = |s: &Sphere| {
-        let q = ((s.center - lo) * scale).as_uvec3();
-        spread(q.x) | (spread(q.y) << 1) | (spread(q.z) << 2)
-    };
-    let mut order: Vec<u32> = (0..spheres.len() as u32).collect();
-    order.sort_by_key(|&i| code(&spheres[i as usize]));
-    order
+    let centres: Vec<_> = spheres.iter().map(|s| s.center).collect();
+    proxima::broad::morton_order(&centres)
 }
 
 impl Engine for Proxima {

@@ -66,7 +66,7 @@ pub use index::{RayHit, SpatialIndex, SweepHit};
 pub use kind::IndexKind;
 pub use loose_kd::{KdNodeView, KdStats, LooseKdConfig, LooseKdTree, Placement};
 pub use nearest::{Metric, Nearest, Neighbor};
-pub use octree::{Face, LinearOctree, LocationCode, OctreeConfig, OctreeStats};
+pub use octree::{morton_order, Face, LinearOctree, LocationCode, OctreeConfig, OctreeStats};
 #[cfg(feature = "parallel")]
 pub use parallel::{par_nearest, par_query_counts, par_visit_batch, NearestBatch, ParallelPairs};
 pub use query::Query;

@@ -20,7 +20,7 @@ mod validate;
 mod tests;
 
 pub(crate) use code::MAX_DEPTH;
-pub use code::{Face, LocationCode};
+pub use code::{morton_order, Face, LocationCode};
 pub use stats::OctreeStats;
 
 use crate::arena::{Arena, Pool};

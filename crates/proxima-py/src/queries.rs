@@ -217,9 +217,18 @@ pub fn nearest(
     if k == 0 || m == 0 {
         return Ok(out);
     }
-    let queries: Vec<Nearest> = points
+    // Run in Morton order: neighbouring queries walk the same nodes, which
+    // stay in cache (measured on 100k points, 100k queries, octree: k = 1
+    // 0.93 -> 0.76 us a query, k = 10 2.53 -> 2.23). Rows are written back
+    // in the caller's order.
+    let order = proxima::broad::morton_order(points);
+    let queries: Vec<Nearest> = order
         .iter()
-        .map(|&p| Nearest::new(p, k).within(max_distance).metric(metric))
+        .map(|&i| {
+            Nearest::new(points[i as usize], k)
+                .within(max_distance)
+                .metric(metric)
+        })
         .collect();
     // A row: the neighbours (handles) as ids, re-ordered when needed.
     let fill = |q: &Nearest,
@@ -258,22 +267,34 @@ pub fn nearest(
     };
     if workers.parallel() {
         let batch = workers.run(|| par_nearest(index, &queries, filter))?;
+        // Row i of the answer is query `rank[i]` of the batch.
+        let mut rank = vec![0u32; m];
+        for (j, &i) in order.iter().enumerate() {
+            rank[i as usize] = j as u32;
+        }
         workers.run(|| {
             (out.distances.par_chunks_mut(k))
                 .zip(out.ids.par_chunks_mut(k))
-                .enumerate()
+                .zip(rank.par_iter())
                 .with_min_len(CHUNK)
-                .for_each_init(Vec::new, |scratch, (i, (d, ids))| {
-                    fill(&queries[i], batch.get(i), scratch, d, ids)
+                .for_each_init(Vec::new, |scratch, ((d, ids), &j)| {
+                    let j = j as usize;
+                    fill(&queries[j], batch.get(j), scratch, d, ids)
                 })
         });
     } else {
         queries.iter().try_for_each(Nearest::validate)?;
         let (mut buf, mut scratch) = (Vec::new(), Vec::new());
-        let rows = out.distances.chunks_mut(k).zip(out.ids.chunks_mut(k));
-        for (q, (d, ids)) in queries.iter().zip(rows) {
+        for (q, &i) in queries.iter().zip(&order) {
             index.nearest_into(q, filter, &mut buf)?;
-            fill(q, &buf, &mut scratch, d, ids);
+            let row = i as usize * k..(i as usize + 1) * k;
+            fill(
+                q,
+                &buf,
+                &mut scratch,
+                &mut out.distances[row.clone()],
+                &mut out.ids[row],
+            );
         }
     }
     Ok(out)

@@ -658,6 +658,18 @@ pub fn point_aabb_distance_sq(p: Vec3, b: &Aabb) -> f64 {
     point_point_distance_sq(p, p.clamp(b.min, b.max))
 }
 
+/// One axis's term of [`point_aabb_distance_sq`]: the squared gap from `p` to
+/// the closed interval `[lo, hi]` (`0` inside), in `f64`. Summed over x, y, z
+/// in that order, the terms equal [`point_aabb_distance_sq`] bit for bit (the
+/// same clamp, difference and products): searches that test many boxes
+/// sharing their intervals (an octree node's 8 children take one of 2 halves
+/// per axis) compute 6 terms instead of 8 boxes. O(1).
+#[inline]
+pub fn axis_gap_sq(p: f32, lo: f32, hi: f32) -> f64 {
+    let d = p as f64 - p.max(lo).min(hi) as f64;
+    d * d
+}
+
 /// Whether the correctly rounded distance `max(0, sqrt(s2) - r)` (as
 /// [`point_sphere_distance`] and [`point_aabb_distance`] compute it, `s2`
 /// from [`point_point_distance_sq`] or [`point_aabb_distance_sq`]) is surely
@@ -1076,6 +1088,34 @@ pub fn distance_squared(a: Vec3, b: Vec3) -> f32 {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn axis_gaps_sum_to_the_box_distance_bit_for_bit() {
+        let mut st = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            st ^= st << 13;
+            st ^= st >> 7;
+            st ^= st << 17;
+            (st >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        };
+        for k in 0..20_000 {
+            let scale = [1e-30f32, 1e-3, 1.0, 1e3, 1e18][k % 5];
+            let v = |n: &mut dyn FnMut() -> f32| Vec3::new(n(), n(), n()) * scale;
+            let (a, b, p) = (v(&mut next), v(&mut next), v(&mut next));
+            // Some points inside, on a face or a corner.
+            let p = match k % 7 {
+                0 => a.min(b),
+                1 => Vec3::new(a.x.min(b.x), p.y, p.z),
+                _ => p,
+            };
+            let bx = Aabb::new(a.min(b), a.max(b));
+            let sum = axis_gap_sq(p.x, bx.min.x, bx.max.x)
+                + axis_gap_sq(p.y, bx.min.y, bx.max.y)
+                + axis_gap_sq(p.z, bx.min.z, bx.max.z);
+            let whole = point_aabb_distance_sq(p, &bx);
+            assert_eq!(sum.to_bits(), whole.to_bits(), "{p:?} {bx:?}");
+        }
+    }
 
     #[test]
     fn candidates4_agree_with_the_scalar_pre_test_and_never_drop_an_overlap() {

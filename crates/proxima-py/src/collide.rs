@@ -14,13 +14,51 @@ use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PySlice;
 use rayon::prelude::*;
+use std::any::Any;
+use std::cell::RefCell;
 
 /// One pose's answer: its triangle pairs (all, or the first) and counters.
 type PoseResult = (Vec<(u32, u32)>, CostCounters);
 
-/// Every pose of a batch (poses validated), on the calling thread with one
-/// collider or on the pool with one collider per task.
-fn run<BV: BoundingVolume>(
+thread_local! {
+    /// This thread's colliders, at most one per bounding volume, kept between
+    /// calls: a new collider sizes its caches to the meshes on its first query
+    /// (filling every entry; for rob × env ~2/3 of a first-contact call), a
+    /// kept one starts a query in O(1). Each holds scratch space for the
+    /// largest meshes it has met, until the thread ends.
+    static COLLIDERS: RefCell<Vec<Box<dyn Any>>> = const { RefCell::new(Vec::new()) };
+}
+
+/// `f` with this thread's collider for `BV` (see [`COLLIDERS`]), set to
+/// `rotation`; a new collider if this thread's is in use (re-entered).
+fn with_collider<BV: BoundingVolume + 'static, R>(
+    rotation: RotationUpdate,
+    f: impl FnOnce(&mut Collider<BV>) -> R,
+) -> R {
+    COLLIDERS.with(|cell| {
+        let Ok(mut kept) = cell.try_borrow_mut() else {
+            return f(&mut Collider::new(rotation));
+        };
+        let i = match kept.iter().position(|c| c.is::<Collider<BV>>()) {
+            Some(i) => i,
+            None => {
+                kept.push(Box::new(Collider::<BV>::new(rotation)));
+                kept.len() - 1
+            }
+        };
+        match kept[i].downcast_mut::<Collider<BV>>() {
+            Some(c) => {
+                c.rotation = rotation;
+                f(c)
+            }
+            None => f(&mut Collider::new(rotation)),
+        }
+    })
+}
+
+/// Every pose of a batch (poses validated), on the calling thread or on the
+/// pool, each thread with its kept collider ([`with_collider`]).
+fn run<BV: BoundingVolume + 'static>(
     a: &RsMesh<BV>,
     b: &RsMesh<BV>,
     poses: &[Affine3A],
@@ -43,12 +81,11 @@ fn run<BV: BoundingVolume>(
                 .par_iter()
                 // A pose costs tens of microseconds: a few per task.
                 .with_min_len(4)
-                .map_init(|| Collider::new(rotation), one)
+                .map(|p| with_collider(rotation, |c| one(c, p)))
                 .collect()
         })
     } else {
-        let mut c = Collider::new(rotation);
-        poses.iter().map(|p| one(&mut c, p)).collect()
+        with_collider(rotation, |c| poses.iter().map(|p| one(c, p)).collect())
     }
 }
 

@@ -157,15 +157,16 @@ pub struct Contacts {
 /// making, and later freeing, the four arrays of a one-pose answer cost ~1 µs,
 /// as much as a first-contact query of rob × env.
 struct LazyArray<T> {
-    /// The values and the array's shape, until the array is made.
-    pending: Mutex<Option<(Vec<T>, Vec<usize>)>>,
+    /// The values and the array's shape (stored inline: no allocation),
+    /// until the array is made.
+    pending: Mutex<Option<(Vec<T>, IxDyn)>>,
     array: PyOnceLock<Py<PyAny>>,
 }
 
 impl<T: Element> LazyArray<T> {
     fn new(values: Vec<T>, shape: &[usize]) -> Self {
         LazyArray {
-            pending: Mutex::new(Some((values, shape.to_vec()))),
+            pending: Mutex::new(Some((values, IxDyn(shape)))),
             array: PyOnceLock::new(),
         }
     }
@@ -181,7 +182,7 @@ impl<T: Element> LazyArray<T> {
                     .take();
                 let (values, shape) = pending
                     .ok_or_else(|| PyRuntimeError::new_err("Contacts: an array was lost"))?;
-                let a = ArrayD::from_shape_vec(IxDyn(&shape), values)
+                let a = ArrayD::from_shape_vec(shape, values)
                     .map_err(|e| PyRuntimeError::new_err(format!("Contacts: {e}")))?;
                 Ok(a.into_pyarray(py).into_any().unbind())
             })

@@ -64,7 +64,7 @@ pub fn f32_values(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<usize>, V
     let err = |e| PyValueError::new_err(format!("{what}: {e}"));
     // numpy's default float64, C order (a pose, a row of points): rounded
     // here as numpy's cast would (to nearest), without the `asarray` call and
-    // the temporary array that cost a one-pose `collide` ~1 µs.
+    // the temporary array that cost a one-pose `collide` ~0.8 µs (perf).
     if let Ok(x) = a.cast::<PyArrayDyn<f64>>() {
         if x.is_c_contiguous() {
             let values = x.to_vec().map_err(err)?;

@@ -5,22 +5,63 @@ use crate::arrays;
 use crate::errors::OrRaise;
 use crate::mesh::{AnyMesh, Mesh};
 use crate::workers::Workers;
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::ndarray::{ArrayD, IxDyn};
+use numpy::{Element, IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyArrayMethods};
 use proxima::glam::Affine3A;
 use proxima::narrow::{
     check_pose, BoundingVolume, Collider, CostCounters, Mesh as RsMesh, RotationUpdate,
 };
-use pyo3::exceptions::{PyIndexError, PyValueError};
+use pyo3::exceptions::{PyIndexError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
 use pyo3::types::PySlice;
 use rayon::prelude::*;
+use std::any::Any;
+use std::cell::RefCell;
+use std::sync::{Mutex, PoisonError};
 
 /// One pose's answer: its triangle pairs (all, or the first) and counters.
 type PoseResult = (Vec<(u32, u32)>, CostCounters);
 
-/// Every pose of a batch (poses validated), on the calling thread with one
-/// collider or on the pool with one collider per task.
-fn run<BV: BoundingVolume>(
+thread_local! {
+    /// This thread's colliders, at most one per bounding volume, kept between
+    /// calls: a new collider sizes its caches to the meshes on its first query
+    /// (filling every entry; for rob × env ~2/3 of a first-contact call), a
+    /// kept one starts a query in O(1). Each holds scratch space for the
+    /// largest meshes it has met, until the thread ends.
+    static COLLIDERS: RefCell<Vec<Box<dyn Any>>> = const { RefCell::new(Vec::new()) };
+}
+
+/// `f` with this thread's collider for `BV` (see [`COLLIDERS`]), set to
+/// `rotation`; a new collider if this thread's is in use (re-entered).
+fn with_collider<BV: BoundingVolume + 'static, R>(
+    rotation: RotationUpdate,
+    f: impl FnOnce(&mut Collider<BV>) -> R,
+) -> R {
+    COLLIDERS.with(|cell| {
+        let Ok(mut kept) = cell.try_borrow_mut() else {
+            return f(&mut Collider::new(rotation));
+        };
+        let i = match kept.iter().position(|c| c.is::<Collider<BV>>()) {
+            Some(i) => i,
+            None => {
+                kept.push(Box::new(Collider::<BV>::new(rotation)));
+                kept.len() - 1
+            }
+        };
+        match kept[i].downcast_mut::<Collider<BV>>() {
+            Some(c) => {
+                c.rotation = rotation;
+                f(c)
+            }
+            None => f(&mut Collider::new(rotation)),
+        }
+    })
+}
+
+/// Every pose of a batch (poses validated), on the calling thread or on the
+/// pool, each thread with its kept collider ([`with_collider`]).
+fn run<BV: BoundingVolume + 'static>(
     a: &RsMesh<BV>,
     b: &RsMesh<BV>,
     poses: &[Affine3A],
@@ -43,12 +84,11 @@ fn run<BV: BoundingVolume>(
                 .par_iter()
                 // A pose costs tens of microseconds: a few per task.
                 .with_min_len(4)
-                .map_init(|| Collider::new(rotation), one)
+                .map(|p| with_collider(rotation, |c| one(c, p)))
                 .collect()
         })
     } else {
-        let mut c = Collider::new(rotation);
-        poses.iter().map(|p| one(&mut c, p)).collect()
+        with_collider(rotation, |c| poses.iter().map(|p| one(c, p)).collect())
     }
 }
 
@@ -98,42 +138,117 @@ pub fn rotation_update(name: &str) -> PyResult<RotationUpdate> {
 ///   updates for the pose).
 ///
 /// `len(contacts)` is N; `bool(contacts)` is whether any pose collides.
-#[pyclass(module = "proxima", name = "Contacts", frozen, get_all)]
+///
+/// The arrays are made on first access (the same objects afterwards): a
+/// one-pose call whose answer is only tested for truth makes none.
+#[pyclass(module = "proxima", name = "Contacts", frozen)]
 pub struct Contacts {
-    pairs: Py<PyArray2<i64>>,
-    offsets: Py<PyArray1<i64>>,
-    colliding: Py<PyArray1<bool>>,
-    counters: Py<PyArray2<u64>>,
+    /// N, the number of poses.
+    poses: usize,
+    /// K, the number of pairs.
+    n_pairs: usize,
+    pairs: LazyArray<i64>,
+    offsets: LazyArray<i64>,
+    colliding: LazyArray<bool>,
+    counters: LazyArray<u64>,
+}
+
+/// An array of a [`Contacts`], made from the query's values on first access:
+/// making, and later freeing, the four arrays (and two reshape views) of a
+/// one-pose answer cost ~1 µs per call (perf, rob × env first contact: a
+/// fifth of the call).
+struct LazyArray<T> {
+    /// The values and the array's shape (stored inline: no allocation),
+    /// until the array is made.
+    pending: Mutex<Option<(Vec<T>, IxDyn)>>,
+    array: PyOnceLock<Py<PyAny>>,
+}
+
+impl<T: Element> LazyArray<T> {
+    fn new(values: Vec<T>, shape: &[usize]) -> Self {
+        LazyArray {
+            pending: Mutex::new(Some((values, IxDyn(shape)))),
+            array: PyOnceLock::new(),
+        }
+    }
+
+    /// The array (its values moved in, not copied), made on the first call.
+    fn get<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.array
+            .get_or_try_init(py, || {
+                let pending = self
+                    .pending
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner)
+                    .take();
+                let (values, shape) = pending
+                    .ok_or_else(|| PyRuntimeError::new_err("Contacts: an array was lost"))?;
+                let a = ArrayD::from_shape_vec(shape, values)
+                    .map_err(|e| PyRuntimeError::new_err(format!("Contacts: {e}")))?;
+                Ok(a.into_pyarray(py).into_any().unbind())
+            })
+            .map(|a| a.bind(py).clone())
+    }
+
+    /// `f` of the values: the query's, or the array's once made (the caller
+    /// may have written to it).
+    fn read<R>(&self, py: Python<'_>, f: impl FnOnce(&[T]) -> R) -> PyResult<R> {
+        if let Some((values, _)) = &*self.pending.lock().unwrap_or_else(PoisonError::into_inner) {
+            return Ok(f(values));
+        }
+        let array = self.get(py)?;
+        let array = array.cast::<PyArrayDyn<T>>()?.try_readonly()?;
+        Ok(f(array.as_slice()?))
+    }
 }
 
 #[pymethods]
 impl Contacts {
-    fn __len__(&self, py: Python<'_>) -> usize {
-        self.colliding.bind(py).shape()[0]
+    /// (K, 2) int64: the intersecting triangle pairs, pose after pose.
+    #[getter]
+    fn pairs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.pairs.get(py)
+    }
+
+    /// (N + 1,) int64: pose i's pairs are `pairs[offsets[i]:offsets[i+1]]`.
+    #[getter]
+    fn offsets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.offsets.get(py)
+    }
+
+    /// (N,) bool: whether pose i has an intersecting pair.
+    #[getter]
+    fn colliding<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.colliding.get(py)
+    }
+
+    /// (N, 3) uint64: the cost counters (nv, np, nu) of each query.
+    #[getter]
+    fn counters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.counters.get(py)
+    }
+
+    fn __len__(&self) -> usize {
+        self.poses
     }
 
     fn __bool__(&self, py: Python<'_>) -> PyResult<bool> {
-        Ok(self
-            .colliding
-            .bind(py)
-            .readonly()
-            .as_slice()?
-            .iter()
-            .any(|&c| c))
+        self.colliding.read(py, |c| c.iter().any(|&c| c))
     }
 
     /// The (K_i, 2) triangle pairs of pose `i` (a view of `pairs`).
     fn __getitem__<'py>(&self, py: Python<'py>, i: isize) -> PyResult<Bound<'py, PyAny>> {
-        csr_row(self.offsets.bind(py), self.pairs.bind(py), i, "pose")
+        let (offsets, pairs) = (self.offsets.get(py)?, self.pairs.get(py)?);
+        csr_row(offsets.cast()?, pairs.cast()?, i, "pose")
     }
 
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        let colliding = self.colliding.bind(py).readonly();
-        let c = colliding.as_slice()?.iter().filter(|&&c| c).count();
+        let c = self
+            .colliding
+            .read(py, |c| c.iter().filter(|&&c| c).count())?;
         Ok(format!(
             "Contacts(poses={}, colliding={c}, pairs={})",
-            self.__len__(py),
-            self.pairs.bind(py).shape()[0]
+            self.poses, self.n_pairs
         ))
     }
 }
@@ -192,15 +307,15 @@ pub fn collide(
             ))
         })?
         .or_raise()?;
-    contacts(py, results)
+    Ok(contacts(results))
 }
 
 // issue #15: `distance(a, b, poses, *, workers=1)` -> distances (N,) and the
 // closest points (N, 2, 3) over the meshes' distance queries goes beside
 // `collide` here, with the same pose handling, once `narrow/distance` lands.
 
-/// Packs per-pose results into the arrays of a [`Contacts`].
-fn contacts(py: Python<'_>, results: Vec<PoseResult>) -> PyResult<Contacts> {
+/// Packs per-pose results into the values of a [`Contacts`].
+fn contacts(results: Vec<PoseResult>) -> Contacts {
     let n = results.len();
     let k: usize = results.iter().map(|r| r.0.len()).sum();
     let mut pairs = Vec::with_capacity(2 * k);
@@ -214,10 +329,12 @@ fn contacts(py: Python<'_>, results: Vec<PoseResult>) -> PyResult<Contacts> {
         offsets.push((pairs.len() / 2) as i64);
         counters.extend([c.nv, c.np, c.nu]);
     }
-    Ok(Contacts {
-        pairs: PyArray1::from_vec(py, pairs).reshape([k, 2])?.unbind(),
-        offsets: PyArray1::from_vec(py, offsets).unbind(),
-        colliding: PyArray1::from_vec(py, colliding).unbind(),
-        counters: PyArray1::from_vec(py, counters).reshape([n, 3])?.unbind(),
-    })
+    Contacts {
+        poses: n,
+        n_pairs: k,
+        pairs: LazyArray::new(pairs, &[k, 2]),
+        offsets: LazyArray::new(offsets, &[n + 1]),
+        colliding: LazyArray::new(colliding, &[n]),
+        counters: LazyArray::new(counters, &[n, 3]),
+    }
 }

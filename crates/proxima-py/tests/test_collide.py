@@ -4,6 +4,7 @@ CLI's answers (`proxima collide A B --poses F --stats`) on the shared meshes."""
 from __future__ import annotations
 
 import subprocess
+import threading
 
 import brute
 import numpy as np
@@ -98,6 +99,130 @@ def test_rotation_modes_agree(rng):
     np.testing.assert_array_equal(
         proxima.collide(a, a, poses, rotation="conservative").counters, ref.counters
     )
+
+
+def on_a_new_thread(f):
+    """f() on a thread of its own: proxima keeps one collider per thread and
+    bounding volume, so this one starts from new colliders."""
+    out = []
+    t = threading.Thread(target=lambda: out.append(f()))
+    t.start()
+    t.join()
+    assert len(out) == 1, "f raised on its thread"
+    return out[0]
+
+
+def one_pose_answer(c):
+    return c.pairs.copy(), c.counters[0].copy(), bool(c)
+
+
+@pytest.mark.parametrize("bv", BVS)
+def test_kept_colliders_answer_as_new_ones(bv, rng):
+    # Meshes of two sizes in turn, so that a thread's kept collider meets
+    # larger and smaller meshes and holds entries of other meshes and poses.
+    small = proxima.Mesh(*soup(rng, 30), bv=bv)
+    big = proxima.Mesh(*soup(rng, 300, size=0.15), bv=bv)
+    cases = [(small, small), (big, small), (small, big), (big, big)]
+    n = 12
+    rot = brute.random_rotations(rng, n)
+    rot[:3] = np.eye(3)  # pure translations take another path
+    poses = brute.poses(rot, rng.uniform(-0.5, 0.5, (n, 3)))
+    modes = [(first, rotation) for first in (False, True) for rotation in ("auto", "refit")]
+    # The reference: every query alone, with new colliders.
+    want = {
+        (i, m, k): on_a_new_thread(
+            lambda: one_pose_answer(proxima.collide(a, b, poses[k], first=first, rotation=rotation))
+        )
+        for i, (a, b) in enumerate(cases)
+        for m, (first, rotation) in enumerate(modes)
+        for k in range(n)
+    }
+    assert 10 < sum(hit for _, _, hit in want.values()) < len(want)
+    # One-pose calls on this thread, cases and modes interleaved.
+    for k in range(n):
+        for i, (a, b) in enumerate(cases):
+            for m, (first, rotation) in enumerate(modes):
+                got = one_pose_answer(proxima.collide(a, b, poses[k], first=first, rotation=rotation))
+                pairs, counters, hit = want[i, m, k]
+                np.testing.assert_array_equal(got[0], pairs)
+                np.testing.assert_array_equal(got[1], counters)
+                assert got[2] == hit
+    # Batches, here and on a pool (its threads keep colliders too).
+    for workers in (1, 2, 1, 2):
+        for i, (a, b) in enumerate(cases):
+            for m, (first, rotation) in enumerate(modes):
+                c = proxima.collide(a, b, poses, first=first, rotation=rotation, workers=workers)
+                for k in range(n):
+                    pairs, counters, hit = want[i, m, k]
+                    np.testing.assert_array_equal(c[k], pairs)
+                    np.testing.assert_array_equal(c.counters[k], counters)
+                    assert c.colliding[k] == hit
+
+
+def test_contacts_arrays_are_made_once_and_stay_the_callers():
+    floor = proxima.Mesh(SQUARE_V, SQUARE_F)
+    pose = np.eye(4)
+    pose[:3, :3] = rotation_x(0.5)
+    pose[:3, 3] = [0.2, 0.2, -0.3]
+    want, _ = brute.mesh_pairs(SQUARE_V, SQUARE_F, SQUARE_V, SQUARE_F, pose)
+    k = len(want)
+    assert k >= 2
+    # Before any array is made: len, bool, repr, indexing.
+    c = proxima.collide(floor, floor, pose)
+    assert len(c) == 1 and bool(c)
+    assert repr(c) == f"Contacts(poses=1, colliding=1, pairs={k})"
+    assert set(map(tuple, proxima.collide(floor, floor, pose)[0].tolist())) == want
+    # Each array: its dtype and shape, C order, writable, the same object each time.
+    for name, dtype, shape in [
+        ("pairs", np.int64, (k, 2)),
+        ("offsets", np.int64, (2,)),
+        ("colliding", np.bool_, (1,)),
+        ("counters", np.uint64, (1, 3)),
+    ]:
+        x = getattr(c, name)
+        assert x is getattr(c, name), name
+        assert x.dtype == dtype and x.shape == shape, name
+        assert x.flags.c_contiguous and x.flags.writeable, name
+    assert set(map(tuple, c.pairs.tolist())) == want and c.offsets.tolist() == [0, k]
+    # What the caller writes into them is what the object answers from.
+    c.colliding[0] = False
+    assert not c and repr(c) == f"Contacts(poses=1, colliding=0, pairs={k})"
+    c.offsets[1] = 1
+    np.testing.assert_array_equal(c[0], c.pairs[:1])
+    # An empty answer.
+    far = pose.copy()
+    far[2, 3] = 5.0
+    e = proxima.collide(floor, floor, far, first=True)
+    assert not e and len(e) == 1 and e.pairs.shape == (0, 2) and e[0].shape == (0, 2)
+    assert e.colliding.tolist() == [False] and e.offsets.tolist() == [0, 0]
+
+
+def test_pose_dtypes_and_layouts_agree(rng):
+    a = proxima.Mesh(*soup(rng, 60))
+    poses = brute.poses(brute.random_rotations(rng, 10), rng.uniform(-0.5, 0.5, (10, 3)))
+    ref = proxima.collide(a, a, poses)
+    assert ref.pairs.shape[0] > 10
+    # float64 in C order is rounded in Rust; the other forms go through numpy.
+    for other in (poses.astype(np.float32), poses.astype(">f8"), np.asfortranarray(poses), poses.tolist()):
+        c = proxima.collide(a, a, other)
+        np.testing.assert_array_equal(c.pairs, ref.pairs)
+        np.testing.assert_array_equal(c.counters, ref.counters)
+    for k in range(3):
+        np.testing.assert_array_equal(proxima.collide(a, a, poses[k]).pairs, ref[k])
+    # The same rounding as numpy's cast, ties and float32's extremes included.
+    v = np.concatenate([
+        rng.uniform(-1e3, 1e3, 300),
+        1 + np.arange(1, 61) * 2.0**-25,  # halfway and quarter points between float32s
+        [3.4028234663852886e38, 3.40282350e38, 1.401298464324817e-45, 7e-46, -2.0**-150, 1e-310, 0.0, -0.0],
+    ])
+    v = np.concatenate([v, np.zeros(-len(v) % 3)]).reshape(-1, 3)
+    m = proxima.Mesh(v, np.arange(len(v) - len(v) % 3).reshape(-1, 3))
+    np.testing.assert_array_equal(m.vertices.view(np.uint32), v.astype(np.float32).view(np.uint32))
+    # Out of float32's range: not finite, as before.
+    p = np.eye(4)
+    p[0, 3] = 1e300
+    with pytest.raises(ValueError, match=r"poses: pose 0 has a non-finite value"):
+        proxima.collide(a, a, p)
 
 
 def write_poses(path, poses):

@@ -97,38 +97,31 @@ pub(crate) fn dilate(v: u32) -> u64 {
 
 /// The indices of `points` sorted along the Morton (Z-order) curve over the
 /// cube spanned by the points' bounding box, on a `2^21` grid per axis (ties
-/// by index): a batch
-/// of queries run in this order visits the same nodes and objects one query
-/// after another, so they stay in cache [sources: octree-code]. Non-finite
-/// coordinates are allowed (the batch checks them itself): they go to the
-/// grid's edges. Cost: O(m log m) for `m` points, one allocation besides the
-/// answer.
+/// by index): a batch of queries run in this order visits the same nodes and
+/// objects one query after another, so they stay in cache [sources:
+/// octree-code]. Each key is the octree's own placement key of the point.
+/// Non-finite coordinates are allowed (the batch checks them itself): they
+/// get some key, never a panic. Cost: O(m log m) for `m` points, one
+/// allocation besides the answer.
 pub fn morton_order(points: &[Vec3]) -> Vec<u32> {
     let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
     for p in points.iter().filter(|p| p.is_finite()) {
         lo = lo.min(*p);
         hi = hi.max(*p);
     }
-    // One scale for all axes, so cells stay cubes in a flat or long set; in
-    // f64, so that a box as wide as the f32 range does not overflow.
-    let top = ((1u32 << MAX_DEPTH) - 1) as f64;
+    // One scale for all axes, so cells stay cubes in a flat or long set; the
+    // width in f64, so that a box as wide as the f32 range keeps a finite
+    // scale.
     let w = (0..3)
         .map(|a| hi[a] as f64 - lo[a] as f64)
         .fold(0.0, f64::max);
-    let s = if w > 0.0 { top / w } else { 0.0 };
-    let cell = |v: f32, l: f32| {
-        // `as u32` saturates, and sends NaN to 0.
-        ((v as f64 - l as f64) * s).min(top) as u32
-    };
+    let top = ((1u32 << MAX_DEPTH) - 1) as f64;
+    let scale = Vec3::splat(if w > 0.0 { (top / w) as f32 } else { 0.0 });
+    let max = lo + Vec3::splat(w as f32);
     let mut keyed: Vec<(u64, u32)> = points
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            let key = dilate(cell(p.x, lo.x))
-                | dilate(cell(p.y, lo.y)) << 1
-                | dilate(cell(p.z, lo.z)) << 2;
-            (key, i as u32)
-        })
+        .map(|(i, &p)| (point_key(lo, max, scale, p), i as u32))
         .collect();
     keyed.sort_unstable();
     keyed.into_iter().map(|(_, i)| i).collect()

@@ -159,6 +159,23 @@ pub(crate) fn finish(out: &mut Vec<Neighbor>, k: usize) {
     out.sort_unstable_by(Neighbor::order);
 }
 
+/// Where `n` goes in `h` (sorted by [`Neighbor::order`]): after every entry
+/// that [precedes](Neighbor::precedes) it. A binary search on the distances
+/// alone (one float comparison a step), then a step over the entries at
+/// `n`'s distance that precede it: entries with equal float distances
+/// (`-0.0` and `0.0` included) are contiguous in that order, and among them
+/// `precedes` is `order`. The same index as
+/// `h.partition_point(|e| Neighbor::precedes(e, n))` (tested), at about half
+/// its cost (callgrind W7, k = 100). O(log k + ties).
+#[inline]
+pub(crate) fn insertion_point(h: &[Neighbor], n: &Neighbor) -> usize {
+    let mut i = h.partition_point(|e| e.distance < n.distance);
+    while i < h.len() && h[i].distance == n.distance && Neighbor::order(&h[i], n).is_lt() {
+        i += 1;
+    }
+    i
+}
+
 /// Up to this `k`, [`KBest`] keeps its candidates sorted (an insertion costs
 /// a binary search and a move of at most `k` entries, and the answer needs no
 /// final sort); above it, a binary heap (O(log k) per insertion, a sort at the
@@ -256,7 +273,7 @@ impl<'a> KBest<'a> {
                 }
                 h.pop();
             }
-            let i = h.partition_point(|e| Neighbor::precedes(e, &n));
+            let i = insertion_point(h, &n);
             h.insert(i, n);
             if h.len() == k {
                 let worst = h[k - 1].distance;
@@ -618,6 +635,39 @@ mod tests {
                     Neighbor::precedes(a, b),
                     Neighbor::order(a, b).is_lt(),
                     "{a:?} {b:?}"
+                );
+            }
+        }
+    }
+
+    /// `insertion_point` is the binary search on `precedes` it replaces, on
+    /// sorted buffers of every length up to 40 drawn from few distances
+    /// (long runs of equal distances, `-0.0` beside `0.0`, subnormals, `∞`)
+    /// and few handles (duplicates), for candidates inside and outside them.
+    #[test]
+    fn insertion_point_is_the_precedes_search() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(41);
+        let ds = [
+            -0.0f32,
+            0.0,
+            f32::from_bits(1),
+            1.0,
+            1.0 + f32::EPSILON,
+            f32::INFINITY,
+        ];
+        let mut pick = |rng: &mut rand_pcg::Pcg64| {
+            neighbor(rng.gen_range(0..8), ds[rng.gen_range(0..ds.len())])
+        };
+        for _ in 0..4000 {
+            let len = rng.gen_range(0..=40);
+            let mut h: Vec<Neighbor> = (0..len).map(|_| pick(&mut rng)).collect();
+            h.sort_unstable_by(Neighbor::order);
+            for _ in 0..8 {
+                let n = pick(&mut rng);
+                assert_eq!(
+                    insertion_point(&h, &n),
+                    h.partition_point(|e| Neighbor::precedes(e, &n)),
+                    "{n:?} into {h:?}"
                 );
             }
         }

@@ -655,7 +655,7 @@ mod tests {
             1.0 + f32::EPSILON,
             f32::INFINITY,
         ];
-        let mut pick = |rng: &mut rand_pcg::Pcg64| {
+        let pick = |rng: &mut rand_pcg::Pcg64| {
             neighbor(rng.gen_range(0..8), ds[rng.gen_range(0..ds.len())])
         };
         for _ in 0..4000 {

@@ -1,13 +1,67 @@
 //! k nearest neighbours [sources: index-queries]: a depth-first branch and
-//! bound over the loose boxes, nearer octant first, with the bounded candidate set of
+//! bound over the loose boxes, nearer octant first, or for large `k` a
+//! best-first search over the same boxes, with the bounded candidate set of
 //! `broad/nearest.rs`.
 
-use super::node::NONE;
+use super::node::{Node, NONE};
 use super::query::child_coords;
 use super::LinearOctree;
 use crate::broad::nearest::{KBest, Nearest, Neighbor};
 use crate::broad::Filter;
 use crate::geom::overlap;
+use std::cell::RefCell;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// From this `k` on the search is best-first (a frontier of nodes ordered by
+/// their boxes' distances) instead of depth-first: with many answers spread
+/// over many leaves, the depth-first order fills the candidate set from the
+/// far corners of the first subtrees and evicts them later, while best-first
+/// visits leaves strictly nearest first and stops at the first node beyond the
+/// bound. Below it the depth-first walk needs no frontier and is cheaper.
+/// Measured (`w7 --n 100000`, two runs each): best-first at k = 10 took
+/// 3.04-3.59 µs a query against 2.82-3.16 depth-first; at k = 100 the
+/// candidate insertions fell 23% (callgrind) and the time ~10%.
+const BEST_FIRST_MIN_K: usize = 32;
+
+/// A node waiting in the best-first search: the squared distance from the
+/// query point to its box (the heap's key, smallest first), the node, its
+/// cell coordinates and depth.
+#[derive(Clone, Copy)]
+struct Pending {
+    dist_sq: f64,
+    node: u32,
+    c: [u32; 3],
+    d: u32,
+}
+
+impl PartialEq for Pending {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+
+impl Eq for Pending {}
+
+impl PartialOrd for Pending {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl Ord for Pending {
+    /// Reversed, so that `BinaryHeap` (a max-heap) pops the nearest first.
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.dist_sq.total_cmp(&self.dist_sq)
+    }
+}
+
+thread_local! {
+    /// The best-first frontier, kept per thread between queries so that a
+    /// search allocates nothing once it has grown (a search runs no user code,
+    /// so it is never re-entered; a failed borrow would use a fresh heap).
+    static FRONTIER: RefCell<BinaryHeap<Pending>> = const { RefCell::new(BinaryHeap::new()) };
+}
 
 impl<T> LinearOctree<T> {
     /// The `k` nearest into `out`, nearest first, ties by handle.
@@ -22,7 +76,9 @@ impl<T> LinearOctree<T> {
     /// that could have entered and the answer is brute force's, bit for bit.
     /// Candidates are tested the same way before their exact distance
     /// (`Metric::distance_within`). Octants are searched nearest first (at
-    /// most 8 sorted on the stack per level). The filter is checked at each
+    /// most 8 sorted on the stack per level), or from
+    /// `BEST_FIRST_MIN_K` answers on all pending nodes nearest first (a
+    /// per-thread frontier heap). The filter is checked at each
     /// candidate that could enter. No allocation once `out` holds `k` entries.
     pub(super) fn nearest_tree(
         &self,
@@ -36,8 +92,114 @@ impl<T> LinearOctree<T> {
         }
         let n = &self.nodes[self.root];
         let d0 = overlap::point_aabb_distance_sq(q.point, &self.loose_of([0; 3], 0, n.max_extent));
-        self.nearest_node(self.root, [0; 3], 0, d0, q, filter, &mut best);
+        if q.k >= BEST_FIRST_MIN_K {
+            FRONTIER.with(|f| match f.try_borrow_mut() {
+                Ok(mut heap) => self.nearest_best_first(d0, q, filter, &mut best, &mut heap),
+                Err(_) => self.nearest_best_first(d0, q, filter, &mut best, &mut BinaryHeap::new()),
+            });
+        } else {
+            self.nearest_node(self.root, [0; 3], 0, d0, q, filter, &mut best);
+        }
         best.finish();
+    }
+
+    /// The best-first search from the root (whose box is `d0` away): pops the
+    /// nearest pending node, stops when even it lies surely beyond the bound
+    /// (the bound only shrinks, and every other pending node is at least as
+    /// far), offers a leaf's items, and pushes the children that may hold a
+    /// candidate. The same tests as the depth-first [`Self::nearest_node`],
+    /// so the same answer.
+    fn nearest_best_first(
+        &self,
+        d0: f64,
+        q: &Nearest,
+        filter: Option<Filter>,
+        best: &mut KBest<'_>,
+        heap: &mut BinaryHeap<Pending>,
+    ) {
+        heap.clear();
+        heap.push(Pending {
+            dist_sq: d0,
+            node: self.root,
+            c: [0; 3],
+            d: 0,
+        });
+        while let Some(p) = heap.pop() {
+            if best.exceeds_sq(p.dist_sq) {
+                break;
+            }
+            let n = &self.nodes[p.node];
+            if filter.is_some_and(|f| !f.may_interact(n.groups, n.masks)) {
+                continue;
+            }
+            if n.leaf {
+                self.offer_leaf(n, q, filter, best);
+                continue;
+            }
+            let (gx, gy, gz) = self.child_gaps(n, p.c, p.d, q);
+            for (k, &ch) in n.children.iter().enumerate() {
+                if ch == NONE {
+                    continue;
+                }
+                let dc = gx[k & 1] + gy[(k >> 1) & 1] + gz[k >> 2];
+                if !best.exceeds_sq(dc) {
+                    heap.push(Pending {
+                        dist_sq: dc,
+                        node: ch,
+                        c: child_coords(p.c, k),
+                        d: p.d + 1,
+                    });
+                }
+            }
+        }
+    }
+
+    /// Offers every item of leaf `n` that may enter `best`.
+    #[inline]
+    fn offer_leaf(&self, n: &Node, q: &Nearest, filter: Option<Filter>, best: &mut KBest<'_>) {
+        for it in &n.items {
+            let Some(distance) = q.metric.distance_within(q.point, &it.sphere, best) else {
+                continue;
+            };
+            if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
+                best.offer(Neighbor {
+                    handle: it.handle,
+                    distance,
+                });
+            }
+        }
+    }
+
+    /// The squared per-axis gaps from the query point to the two halves of
+    /// inner node `n`'s cell (at coordinates `c`, depth `d`) on each axis,
+    /// grown by `n`'s extent.
+    ///
+    /// The children's loose boxes are their cells grown by this node's
+    /// extent (never below any child's: still every sphere below each
+    /// child is inside). So each axis has two intervals, the cell's low
+    /// and high halves, and the 8 boxes' distances are sums of 6 terms
+    /// (`overlap::axis_gap_sq`, equal to the per-box distance bit for bit):
+    /// no child node is read before it is visited (callgrind, 100k points,
+    /// octree: -15% instructions a query at k = 1, -8% at k = 10).
+    #[inline]
+    fn child_gaps(
+        &self,
+        n: &Node,
+        c: [u32; 3],
+        d: u32,
+        q: &Nearest,
+    ) -> ([f64; 2], [f64; 2], [f64; 2]) {
+        let (size, grow) = (self.cell_size[d as usize + 1], n.max_extent + self.slack);
+        let gap = |a: usize| {
+            let lo = self.cube.min[a] + (c[a] * 2) as f32 * size;
+            let hi = self.cube.min[a] + (c[a] * 2 + 1) as f32 * size;
+            let p = q.point[a];
+            [
+                overlap::axis_gap_sq(p, lo - grow, (lo + size) + grow),
+                overlap::axis_gap_sq(p, hi - grow, (hi + size) + grow),
+            ]
+        };
+        (gap(0), gap(1), gap(2))
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -59,37 +221,10 @@ impl<T> LinearOctree<T> {
             return;
         }
         if n.leaf {
-            for it in &n.items {
-                let Some(distance) = q.metric.distance_within(q.point, &it.sphere, best) else {
-                    continue;
-                };
-                if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
-                    best.offer(Neighbor {
-                        handle: it.handle,
-                        distance,
-                    });
-                }
-            }
+            self.offer_leaf(n, q, filter, best);
             return;
         }
-        // The children's loose boxes are their cells grown by this node's
-        // extent (never below any child's: still every sphere below each
-        // child is inside). So each axis has two intervals, the cell's low
-        // and high halves, and the 8 boxes' distances are sums of 6 terms
-        // (`overlap::axis_gap_sq`, equal to the per-box distance bit for bit):
-        // no child node is read before it is visited (callgrind, 100k points,
-        // octree: -15% instructions a query at k = 1, -8% at k = 10).
-        let (size, grow) = (self.cell_size[d as usize + 1], n.max_extent + self.slack);
-        let gap = |a: usize| {
-            let lo = self.cube.min[a] + (c[a] * 2) as f32 * size;
-            let hi = self.cube.min[a] + (c[a] * 2 + 1) as f32 * size;
-            let p = q.point[a];
-            [
-                overlap::axis_gap_sq(p, lo - grow, (lo + size) + grow),
-                overlap::axis_gap_sq(p, hi - grow, (hi + size) + grow),
-            ]
-        };
-        let (gx, gy, gz) = (gap(0), gap(1), gap(2));
+        let (gx, gy, gz) = self.child_gaps(n, c, d, q);
         let mut order = [(0.0f64, 0u32, [0u32; 3]); 8];
         let mut m = 0;
         for (k, &ch) in n.children.iter().enumerate() {

@@ -230,6 +230,16 @@ struct Loc {
 /// the bounds of everything stored (kept until the tree is next empty or cleared),
 /// so far-away objects make boundary nodes look larger to those queries. Sphere
 /// and box queries, which prune with the split planes only, are unaffected.
+///
+/// **Not the fastest for many small range queries on a static set.** Spheres
+/// stop at every depth (where `r >= h`), so a small sphere or box query reads a
+/// node and a range of objects at each level of its path: cache lines, not
+/// arithmetic, bound it. On W4 (100 000 static spheres, `proxima-bench w4`, a
+/// quiet run, BENCHMARKS.md) its sphere, box and ray queries took 1.9×, 2.5×
+/// and 1.7× the time of rstar's bulk-loaded R-tree, while its frusta were faster
+/// (0.9×). For that use, [`UniformGrid3d`](super::UniformGrid3d) (0.9–1.0× rstar
+/// on spheres and boxes) or [`LinearOctree`](super::LinearOctree) (frusta) fit
+/// better; this tree is built for scenes that move (cheap updates, all pairs).
 #[derive(Clone, Debug)]
 pub struct LooseKdTree<T> {
     /// Handle → location; the objects themselves are in `store`.

@@ -13,7 +13,8 @@
 
 use super::nearest::{self, Nearest, Neighbor};
 use super::{Filter, Query, RayHit, Selection};
-use crate::geom::{overlap, Aabb, Ray, Sphere, SphereSweep};
+use crate::geom::overlap::EntryBound;
+use crate::geom::{overlap, Ray, Sphere, SphereSweep};
 use crate::{Handle, Result};
 use std::ops::ControlFlow;
 
@@ -98,11 +99,13 @@ pub(crate) trait Cast: Selection {
     /// The parameter at which the cast first touches the closed sphere `s`,
     /// or `None` ([`overlap::ray_sphere`], [`overlap::sweep_sphere`]).
     fn contact(&self, s: &Sphere) -> Option<f32>;
-    /// A lower bound on [`Cast::contact`] of every sphere inside `b`, or `None`
-    /// when the cast touches nothing inside it ([`overlap::ray_aabb`],
-    /// [`overlap::sweep_aabb`]); monotone in the box, so front-to-back searches
-    /// may skip a box entered after the best contact so far.
-    fn enter(&self, b: &Aabb) -> Option<f32>;
+    /// The cast prepared for its search's box tests: [`EntryBound::enter`]
+    /// is a lower bound on [`Cast::contact`] of every sphere inside a box
+    /// (below [`overlap::ray_aabb`]'s or [`overlap::sweep_aabb`]'s entry, to
+    /// which `contact` is clamped), and `None` only when the cast touches
+    /// nothing inside it; so front-to-back searches may skip a box entered
+    /// after the best contact so far.
+    fn entry(&self) -> EntryBound;
     /// The line the cast's centre follows, as a ray whose parameter is the
     /// cast's, and how far from that line the cast reaches: `0` for a ray; a
     /// sweep's radius plus the rounding of its direction `to - from` (which
@@ -135,8 +138,8 @@ impl Cast for Ray {
         overlap::ray_sphere(self, s)
     }
     #[inline]
-    fn enter(&self, b: &Aabb) -> Option<f32> {
-        overlap::ray_aabb(self, b).map(|(t0, _)| t0)
+    fn entry(&self) -> EntryBound {
+        EntryBound::ray(self)
     }
     #[inline]
     fn path(&self) -> (Ray, f32) {
@@ -150,8 +153,8 @@ impl Cast for SphereSweep {
         overlap::sweep_sphere(self, s)
     }
     #[inline]
-    fn enter(&self, b: &Aabb) -> Option<f32> {
-        overlap::sweep_aabb(self, b).map(|(t0, _)| t0)
+    fn entry(&self) -> EntryBound {
+        EntryBound::sweep(self)
     }
     /// From `from` along `to - from` up to `t = 1`, reaching the radius plus
     /// 2^-22 of the end points' magnitude (more than the rounding of

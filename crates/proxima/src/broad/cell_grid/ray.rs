@@ -100,9 +100,10 @@ impl<T, S: Store> CellGrid<T, S> {
         };
         // Does the cast touch the spheres reported from `key` by a visit whose
         // ranges start at `from`?
+        let entry = cast.entry();
         let touches = |key: Key, from: Key| {
             let b = self.report_box(&KeyBox::single(key), &KeyBox::single(from), 2.0);
-            cast.enter(&b.grown(extra)).is_some()
+            entry.enter(&b.grown(extra)).is_some()
         };
         let ad = d.abs();
         let (a, b, c) = if S::AXES == 2 {

@@ -7,6 +7,7 @@ use super::LooseKdTree;
 use crate::broad::filter::Admit;
 use crate::broad::walk::Cast;
 use crate::broad::{Filter, RayHit, Selection};
+use crate::geom::overlap::EntryBound;
 use crate::geom::{Aabb, Frustum, Relation, Sphere};
 use crate::Handle;
 use glam::Vec3;
@@ -249,62 +250,140 @@ impl<T> LooseKdTree<T> {
     /// Smallest contact `t` of a ray or sweep (ties: smallest handle) by a
     /// front-to-back walk: children are visited nearer entry first, and a
     /// subtree whose region (which contains all its spheres) the cast enters
-    /// after the best contact so far is skipped. `t` values come from the same
-    /// [`Cast::contact`] as in the default scan, so the answer is identical: a
-    /// pruned box has an entry bound ([`Cast::enter`]) above the best `t`, and
-    /// that bound is at most the `t` of every sphere inside (for a ray: the
-    /// `ray_aabb` entry; for a sweep: `sweep_aabb`'s, which `sweep_sphere`'s
-    /// `t` is clamped to respect). Objects whose filter does not interact with
-    /// `filter` are skipped at the candidate, and subtrees whose filter bits
-    /// cannot interact with it are skipped whole.
+    /// after the best contact so far is skipped; within a node, so is each
+    /// chunk of eight objects whose bound (`store.rs`, plus `eps`) it enters
+    /// after it. `t` values come from the same [`Cast::contact`] as in the
+    /// default scan, so the answer is identical: a pruned box has an entry
+    /// bound ([`EntryBound::enter`]) above the best `t`, and that bound is at
+    /// most the `t` of every sphere inside (`contact` is clamped to the exact
+    /// entry of the sphere's box, which is at least the bound). Children's
+    /// boxes are derived from the parent's (as in [`Self::visit_impl`]), so a
+    /// pruned child is never loaded. Objects whose filter does not interact
+    /// with `filter` are skipped at the candidate, and subtrees whose filter
+    /// bits cannot interact with it are skipped whole.
+    ///
+    /// Measured (W8, 100k sweeps, callgrind): with the exact box tests of
+    /// `ray_aabb`/`sweep_aabb` and no chunk bounds, 57% of the instructions
+    /// were box tests.
     pub(super) fn first_impl<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         if self.root == NIL {
             return None;
         }
+        let entry = cast.entry();
         let mut best: Option<RayHit> = None;
         let beyond = |best: &Option<RayHit>, t: f32| best.is_some_and(|b| t > b.t);
-        let mut stack = FixedStack::<(u32, f32)>::new();
-        if let Some(t0) = cast.enter(&self.region(&self.nodes[self.root])) {
-            stack.push((self.root, t0));
+        let mut stack = FixedStack::<CastPending>::new();
+        let root = &self.nodes[self.root];
+        if let Some(t) = entry.enter(&self.region(root)) {
+            stack.push(CastPending {
+                node: self.root,
+                t,
+                bbox: root.bbox,
+            });
         }
-        while let Some((n, t_enter)) = stack.pop() {
-            if beyond(&best, t_enter) {
+        while let Some(p) = stack.pop() {
+            if beyond(&best, p.t) {
                 continue;
             }
-            let node = &self.nodes[n];
+            let node = &self.nodes[p.node];
             if filter.is_some_and(|f| !f.may_interact(node.groups, node.masks)) {
                 continue;
             }
-            for (q, s) in node.range().zip(&self.store.sphere[node.range()]) {
-                if let Some(t) = cast.contact(s).filter(|&t| !beyond(&best, t)) {
-                    let (h, of, _) = self.store.full(q);
-                    if filter.is_some_and(|f| !f.interacts(of)) {
-                        continue;
-                    }
-                    RayHit::offer(&mut best, t, h);
-                }
-            }
-            let mut entries = [(NIL, f32::INFINITY); 2];
-            for (side, e) in entries.iter_mut().enumerate() {
+            let mut next = [CastPending::default(); 2];
+            let a = node.axis as usize;
+            for (side, e) in next.iter_mut().enumerate() {
                 let c = node.child[side];
-                if c != NIL {
-                    if let Some(t0) = cast.enter(&self.region(&self.nodes[c])) {
-                        if !beyond(&best, t0) {
-                            *e = (c, t0);
-                        }
-                    }
+                if c == NIL {
+                    continue;
+                }
+                // The child's box, from the parent: one face moved to `m ∓ h`.
+                let mut cb = p.bbox;
+                if side == 1 {
+                    cb.min[a] = node.m - node.h;
+                } else {
+                    cb.max[a] = node.m + node.h;
+                }
+                if let Some(t) = entry.enter(&self.region_of_box(&cb)) {
+                    *e = CastPending {
+                        node: c,
+                        t,
+                        bbox: cb,
+                    };
                 }
             }
+            self.first_in_node(node.range(), node.loose, cast, &entry, filter, &mut best);
             // Push the farther first so the nearer is popped first.
-            if entries[0].1 < entries[1].1 {
-                entries.swap(0, 1);
+            if next[0].t < next[1].t {
+                next.swap(0, 1);
             }
-            for e in entries {
-                if e.0 != NIL {
+            for e in next {
+                if e.node != NIL && !beyond(&best, e.t) {
                     stack.push(e);
                 }
             }
         }
         best
+    }
+
+    /// Offers the contacts of the objects at positions `range` (one node's)
+    /// to `best`, chunk by chunk: a chunk whose bound the cast enters after
+    /// `best` (or never) is skipped unread. Short ranges and the objects of
+    /// a `loose` node are tested one by one, as in [`Self::scan`].
+    #[inline(always)]
+    fn first_in_node<C: Cast>(
+        &self,
+        range: Range<usize>,
+        loose: bool,
+        cast: &C,
+        entry: &EntryBound,
+        filter: Option<Filter>,
+        best: &mut Option<RayHit>,
+    ) {
+        let mut p = range.start;
+        while p < range.end {
+            let end = ((p / CHUNK + 1) * CHUNK).min(range.end);
+            if !loose && end - p > 2 {
+                let c = &self.store.chunk[p / CHUNK];
+                let e = Vec3::splat(self.eps);
+                match entry.enter(&Aabb::new(c.min - e, c.max + e)) {
+                    Some(t) if !best.is_some_and(|b| t > b.t) => {}
+                    _ => {
+                        p = end;
+                        continue;
+                    }
+                }
+            }
+            for (q, s) in (p..end).zip(&self.store.sphere[p..end]) {
+                if let Some(t) = cast.contact(s).filter(|&t| !best.is_some_and(|b| t > b.t)) {
+                    let (h, of, _) = self.store.full(q);
+                    if filter.is_some_and(|f| !f.interacts(of)) {
+                        continue;
+                    }
+                    RayHit::offer(best, t, h);
+                }
+            }
+            p = end;
+        }
+    }
+}
+
+/// A node waiting in the first-hit search: its index, a lower bound on the
+/// cast's entry into its region, and its box `B` (derived from the parent's).
+#[derive(Clone, Copy)]
+struct CastPending {
+    node: u32,
+    t: f32,
+    bbox: Aabb,
+}
+
+/// Filler of the fixed stack's unused entries (and of an absent child: no
+/// node, never entered).
+impl Default for CastPending {
+    fn default() -> Self {
+        CastPending {
+            node: NIL,
+            t: f32::INFINITY,
+            bbox: Aabb::EMPTY,
+        }
     }
 }

@@ -7,6 +7,7 @@ use super::query::child_coords;
 use super::LinearOctree;
 use crate::broad::walk::Cast;
 use crate::broad::{Filter, RayHit};
+use crate::geom::overlap::EntryBound;
 
 /// A subtree is skipped only when its box entry `t0` exceeds the best hit by more
 /// than this relative margin: the box and sphere entry parameters are rounded
@@ -18,15 +19,16 @@ const PRUNE_MARGIN: f32 = 1e-4;
 impl<T> LinearOctree<T> {
     /// The contact of a ray or sweep with the smallest `(t, handle)`; children
     /// are visited in order of their loose boxes' entry bound
-    /// ([`Cast::enter`]). No allocation (≤ 8 children sorted on the stack per
+    /// ([`Cast::entry`]). No allocation (≤ 8 children sorted on the stack per
     /// level). Objects whose filter does not interact with `filter` are
     /// skipped at the candidate.
     pub(super) fn first_tree<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best = None;
         if !self.objects.is_empty() {
             let n = &self.nodes[self.root];
-            if let Some(t0) = cast.enter(&self.loose_of([0; 3], 0, n.max_extent)) {
-                self.first_node(self.root, [0; 3], 0, t0, cast, filter, &mut best);
+            let entry = cast.entry();
+            if let Some(t0) = entry.enter(&self.loose_of([0; 3], 0, n.max_extent)) {
+                self.first_node(self.root, [0; 3], 0, t0, cast, &entry, filter, &mut best);
             }
         }
         best
@@ -40,6 +42,7 @@ impl<T> LinearOctree<T> {
         d: u32,
         t0: f32,
         cast: &C,
+        entry: &EntryBound,
         filter: Option<Filter>,
         best: &mut Option<RayHit>,
     ) {
@@ -70,14 +73,14 @@ impl<T> LinearOctree<T> {
             }
             let cc = child_coords(c, k);
             let loose = self.loose_of(cc, d + 1, self.nodes[ch].max_extent);
-            if let Some(ct0) = cast.enter(&loose) {
+            if let Some(ct0) = entry.enter(&loose) {
                 order[m] = (ct0, ch, cc);
                 m += 1;
             }
         }
         order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         for &(ct0, ch, cc) in &order[..m] {
-            self.first_node(ch, cc, d + 1, ct0, cast, filter, best);
+            self.first_node(ch, cc, d + 1, ct0, cast, entry, filter, best);
         }
     }
 }

@@ -3,7 +3,9 @@
 //! [`Selection::selects`], so one traversal serves every query shape. Internal:
 //! users query with [`Query`](super::Query); the trait is sealed and hidden.
 
-use crate::geom::{overlap, Aabb, Frustum, Ray, Relation, Sphere, SphereSweep};
+use super::walk::Cast;
+use crate::geom::overlap::{self, EntryBound};
+use crate::geom::{Aabb, Frustum, Ray, Relation, Sphere, SphereSweep};
 use crate::Result;
 
 pub(crate) mod sealed {
@@ -15,6 +17,7 @@ pub(crate) mod sealed {
     impl Sealed for crate::geom::Ray {}
     impl Sealed for crate::geom::Frustum {}
     impl Sealed for crate::geom::SphereSweep {}
+    impl<C: super::Cast> Sealed for super::Prepared<'_, C> {}
 }
 
 /// A query over stored spheres, as the index walks see it.
@@ -242,6 +245,57 @@ impl Selection for SphereSweep {
     }
     fn as_sweep(&self) -> Option<&SphereSweep> {
         Some(self)
+    }
+}
+
+/// A ray or a sphere sweep prepared for one walk: the same selection as the
+/// cast itself, but its box tests use [`EntryBound::enter`] (the inverse
+/// direction and the growth computed once per walk, no division per box)
+/// instead of the exact [`overlap::ray_aabb`] / [`overlap::sweep_aabb`]:
+/// `None` there only where the exact test says `None` or the exact interval
+/// is empty, so a box holding a touched sphere is never `Outside`. What
+/// [`super::walk::visit`] hands the indices for [`Query::Ray`](super::Query::Ray)
+/// and [`Query::Sweep`](super::Query::Sweep).
+pub(crate) struct Prepared<'a, C: Cast> {
+    cast: &'a C,
+    entry: EntryBound,
+}
+
+impl<'a, C: Cast> Prepared<'a, C> {
+    /// Prepares `cast` (validated). O(1).
+    #[inline]
+    pub(crate) fn new(cast: &'a C) -> Self {
+        Prepared {
+            cast,
+            entry: cast.entry(),
+        }
+    }
+}
+
+impl<C: Cast> Selection for Prepared<'_, C> {
+    fn validate(&self) -> Result<()> {
+        self.cast.validate()
+    }
+    #[inline]
+    fn selects(&self, s: &Sphere) -> bool {
+        self.cast.selects(s)
+    }
+    #[inline]
+    fn classify_box(&self, b: &Aabb, mask: u8) -> (Relation, u8) {
+        if self.entry.enter(b).is_some() {
+            (Relation::Intersecting, mask)
+        } else {
+            (Relation::Outside, mask)
+        }
+    }
+    fn bounds(&self) -> Option<Aabb> {
+        self.cast.bounds()
+    }
+    fn as_ray(&self) -> Option<&Ray> {
+        self.cast.as_ray()
+    }
+    fn as_sweep(&self) -> Option<&SphereSweep> {
+        self.cast.as_sweep()
     }
 }
 

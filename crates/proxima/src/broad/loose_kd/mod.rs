@@ -235,9 +235,10 @@ struct Loc {
 /// stop at every depth (where `r >= h`), so a small sphere or box query reads a
 /// node and a range of objects at each level of its path: cache lines, not
 /// arithmetic, bound it. On W4 (100 000 static spheres, `proxima-bench w4`, a
-/// quiet run, BENCHMARKS.md) its sphere, box and ray queries took 1.9×, 2.5×
-/// and 1.7× the time of rstar's bulk-loaded R-tree, while its frusta were faster
-/// (0.9×). For that use, [`UniformGrid3d`](super::UniformGrid3d) (0.9–1.0× rstar
+/// quiet run, BENCHMARKS.md) its sphere and box queries took 1.9× and 2.5× the
+/// time of rstar's bulk-loaded R-tree, while its rays took 0.94–0.96× (since
+/// casts test boxes with a bound prepared once per ray) and its frusta 0.9×.
+/// For that use, [`UniformGrid3d`](super::UniformGrid3d) (0.9–1.0× rstar
 /// on spheres and boxes) or [`LinearOctree`](super::LinearOctree) (frusta) fit
 /// better; this tree is built for scenes that move (cheap updates, all pairs).
 #[derive(Clone, Debug)]

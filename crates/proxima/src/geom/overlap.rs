@@ -527,11 +527,9 @@ fn sweep_ray(sweep: &SphereSweep) -> Option<(Ray, [f64; 3])> {
 /// computed once, no division per box).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct EntryBound {
-    /// The prepared ray; `None` when the sweep's direction overflows `f32`
-    /// (then every box is entered at 0, as [`sweep_aabb`] says).
+    /// The prepared (thick) ray; `None` when the sweep's direction overflows
+    /// `f32` (then every box is entered at 0, as [`sweep_aabb`] says).
     clip: Option<RayClip>,
-    /// Growth per axis (`0` for a ray), an `f32` at least the exact one.
-    grow: Vec3,
 }
 
 impl EntryBound {
@@ -541,53 +539,40 @@ impl EntryBound {
         let finite = ray.origin.is_finite() && ray.dir.is_finite() && !ray.max_t.is_nan();
         EntryBound {
             clip: finite.then(|| RayClip::new(ray)),
-            grow: Vec3::ZERO,
         }
     }
 
-    /// For a sphere sweep. O(1).
+    /// For a sphere sweep: the ray of [`sweep_aabb`], thick by its growth
+    /// ([`RayClip::thick`]). O(1).
     #[inline]
     pub(crate) fn sweep(sweep: &SphereSweep) -> EntryBound {
-        match sweep_ray(sweep) {
-            Some((ray, grow)) if ray.origin.is_finite() => EntryBound {
-                clip: Some(RayClip::new(&ray)),
-                // Rounded up: the smallest `f32` not below each growth.
-                grow: Vec3::from(grow.map(|g| -round_down(-g))),
-            },
-            _ => EntryBound {
-                clip: None,
-                grow: Vec3::ZERO,
-            },
+        EntryBound {
+            clip: sweep_ray(sweep)
+                .filter(|(ray, g)| ray.origin.is_finite() && g.iter().all(|x| x.is_finite()))
+                .map(|(ray, g)| RayClip::thick(&ray, g)),
         }
     }
 
     /// A parameter at most the `t0` of [`ray_aabb`] (for a ray) or
     /// [`sweep_aabb`] (for a sweep) on `b`, and `None` only when that is
-    /// `None`. So a search that skips a box entered after its best contact
-    /// skips only what the exact test would (and a little less).
+    /// `None` or the exact interval it rounds is empty. So a search that
+    /// skips a box entered after its best contact skips only what the exact
+    /// test would (and a little less).
     ///
-    /// Why it is below: the box grown by `grow` and rounded outward
-    /// (`f32_down` of a rounded difference is at most the exact one) contains
-    /// the box the exact test grows, its exact entry is at most that box's,
-    /// and [`RayClip::clip`]'s interval contains the exact one; its `t0`
-    /// rounded down to `f32` is then at most the exact entry's `f32` floor.
-    /// Infinite sides stay infinite; a NaN side is ignored, as in `clip`.
-    /// Cost: 6 `f32` sums with a step, 6 `f64` products. (Tested against the
-    /// exact tests, including adversarial magnitudes.)
+    /// Why it is below: [`RayClip::thick`]'s interval contains the exact
+    /// interval of the box grown by the sweep's growth (which is what
+    /// `sweep_aabb` grows by, before rounding its box outward to `f32`), its
+    /// `t0` is then at most the exact entry, and rounded down to `f32` at
+    /// most that entry's `f32` floor, `ray_aabb`'s `t0`. Infinite sides stay
+    /// infinite; a NaN side is ignored, as in `clip`. Cost: 6 `f64`
+    /// subtractions and products, no division. (Tested against the exact
+    /// tests, including adversarial magnitudes.)
     #[inline(always)]
     pub(crate) fn enter(&self, b: &Aabb) -> Option<f32> {
         let Some(clip) = &self.clip else {
             return Some(0.0);
         };
-        let t0 = if self.grow == Vec3::ZERO {
-            clip.clip(b)?.0
-        } else {
-            let g = self.grow;
-            let lo = (b.min - g).to_array().map(step_down);
-            let hi = (b.max + g).to_array().map(|x| -step_down(-x));
-            clip.clip(&Aabb::new(Vec3::from(lo), Vec3::from(hi)))?.0
-        };
-        Some(round_down(t0))
+        Some(round_down(clip.clip(b)?.0))
     }
 }
 
@@ -813,6 +798,12 @@ pub(crate) struct RayClip {
     inv: [f64; 3],
     /// Largest parameter.
     max_t: f64,
+    /// The origin the boxes' low sides are measured from: `o`, or for a
+    /// thick ray ([`RayClip::thick`]) at least `o + g` (rounded up).
+    o_hi: [f64; 3],
+    /// The origin the boxes' high sides are measured from: `o`, or at most
+    /// `o - g` (rounded down).
+    o_lo: [f64; 3],
 }
 
 /// Relative widening of [`RayClip`]'s `f64` results: 2^-50 = 8u, with u =
@@ -841,7 +832,38 @@ impl RayClip {
             d,
             inv: d.map(|x| 1.0 / x),
             max_t: ray.max_t as f64,
+            o_hi: o,
+            o_lo: o,
         }
+    }
+
+    /// Prepares `ray` (finite origin, finite direction) to clip boxes grown
+    /// by `g[a] >= 0` on each side of axis `a` without growing them: growing
+    /// the low side of a slab by `g` moves its parameter `(lo - g - o) / d`
+    /// exactly as moving the origin to `o + g` does, so the low sides are
+    /// measured from `o_hi >= o + g` and the high sides from `o_lo <= o - g`
+    /// (each rounded outward once here, per ray). [`RayClip::clip`]'s
+    /// analysis holds unchanged: each slab parameter is still one `f64`
+    /// subtraction of two exact `f64`s, a reciprocal and a product; and the
+    /// outward origins only move the low sides' parameters down and the high
+    /// sides' up for a positive `d` (for a negative `d` the low side is the
+    /// exit and moves up, the high side the entry and moves down), so the
+    /// interval still contains the grown box's exact one. A zero component
+    /// is decided by `o_hi < lo` or `o_lo > hi`, exact comparisons that
+    /// imply `o` is outside the grown slab.
+    #[inline]
+    pub(crate) fn thick(ray: &Ray, g: [f64; 3]) -> RayClip {
+        let mut c = RayClip::new(ray);
+        for a in 0..3 {
+            // Rounded outward: a sum of two finite `f64`s below 2^200 is
+            // within a relative 2^-53 of the exact one, and the factor moves
+            // it by more than that, away from `o` (exact at 0: `o = ∓g`
+            // makes the sum exact by Sterbenz).
+            let (hi, lo) = (c.o[a] + g[a], c.o[a] - g[a]);
+            c.o_hi[a] = widen(hi, true);
+            c.o_lo[a] = widen(lo, false);
+        }
+        c
     }
 
     /// An `f64` interval `[t0, t1]` containing the exact parameter interval
@@ -868,14 +890,17 @@ impl RayClip {
         let mut far = f64::INFINITY;
         for a in 0..3 {
             let (lo, hi) = (mn[a] as f64, mx[a] as f64);
-            let (o, d) = (self.o[a], self.d[a]);
+            let d = self.d[a];
             if d == 0.0 {
-                if o < lo || o > hi {
+                if self.o_hi[a] < lo || self.o_lo[a] > hi {
                     return None;
                 }
                 continue;
             }
-            let (tl, th) = ((lo - o) * self.inv[a], (hi - o) * self.inv[a]);
+            let (tl, th) = (
+                (lo - self.o_hi[a]) * self.inv[a],
+                (hi - self.o_lo[a]) * self.inv[a],
+            );
             let (enter, exit) = if d > 0.0 { (tl, th) } else { (th, tl) };
             // A NaN (NaN side) compares false: ignored.
             if enter > near {

@@ -267,7 +267,8 @@ impl<'a, C: Cast> Prepared<'a, C> {
     pub(crate) fn new(cast: &'a C) -> Self {
         Prepared {
             cast,
-            entry: cast.entry(),
+            // Touch tests only (`Outside` = touches nothing): no magnitude.
+            entry: cast.entry(0.0),
         }
     }
 }

@@ -100,13 +100,16 @@ pub(crate) trait Cast: Selection {
     /// The parameter at which the cast first touches the closed sphere `s`,
     /// or `None` ([`overlap::ray_sphere`], [`overlap::sweep_sphere`]).
     fn contact(&self, s: &Sphere) -> Option<f32>;
-    /// The cast prepared for its search's box tests: [`EntryBound::enter`]
-    /// is a lower bound on [`Cast::contact`] of every sphere inside a box
-    /// (below [`overlap::ray_aabb`]'s or [`overlap::sweep_aabb`]'s entry, to
-    /// which `contact` is clamped), and `None` only when the cast touches
-    /// nothing inside it; so front-to-back searches may skip a box entered
-    /// after the best contact so far.
-    fn entry(&self) -> EntryBound;
+    /// The cast prepared for its search's box tests, over stored spheres
+    /// whose bounding boxes have coordinates of magnitude at most `m`
+    /// ([`EntryBound::sweep`]; `0` for a walk that needs only touch tests):
+    /// [`EntryBound::enter`] is a lower bound on [`Cast::contact`] of every
+    /// sphere inside a box (below [`overlap::ray_aabb`]'s or
+    /// [`overlap::sweep_aabb`]'s entry of the sphere's box, to which
+    /// `contact` is clamped, by monotonicity), and `None` only when the cast
+    /// touches nothing inside it; so front-to-back searches may skip a box
+    /// entered after the best contact so far.
+    fn entry(&self, m: f32) -> EntryBound;
     /// The line the cast's centre follows, as a ray whose parameter is the
     /// cast's, and how far from that line the cast reaches: `0` for a ray; a
     /// sweep's radius plus the rounding of its direction `to - from` (which
@@ -139,7 +142,7 @@ impl Cast for Ray {
         overlap::ray_sphere(self, s)
     }
     #[inline]
-    fn entry(&self) -> EntryBound {
+    fn entry(&self, _m: f32) -> EntryBound {
         EntryBound::ray(self)
     }
     #[inline]
@@ -154,8 +157,8 @@ impl Cast for SphereSweep {
         overlap::sweep_sphere(self, s)
     }
     #[inline]
-    fn entry(&self) -> EntryBound {
-        EntryBound::sweep(self)
+    fn entry(&self, m: f32) -> EntryBound {
+        EntryBound::sweep(self, m)
     }
     /// From `from` along `to - from` up to `t = 1`, reaching the radius plus
     /// 2^-22 of the end points' magnitude (more than the rounding of

@@ -522,9 +522,9 @@ fn sweep_ray(sweep: &SphereSweep) -> Option<(Ray, [f64; 3])> {
 /// tests two child boxes per node and a chunk bound per eight objects: W8
 /// (100k sweeps through W4's set, callgrind) spent 57% of the loose k-d
 /// tree's instructions in them. A pruning bound needs only to be *below* the
-/// exact entry: this one grows the box outward in `f32` by the sweep's
-/// growth (rounded up) and clips with [`RayClip`] (the inverse direction
-/// computed once, no division per box).
+/// exact entry of every sphere inside: this one clips with [`RayClip`] (the
+/// inverse direction computed once, no division per box), for a sweep thick
+/// by its growth ([`RayClip::thick`]: the box is not grown at all).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct EntryBound {
     /// The prepared (thick) ray; `None` when the sweep's direction overflows
@@ -543,28 +543,49 @@ impl EntryBound {
     }
 
     /// For a sphere sweep: the ray of [`sweep_aabb`], thick by its growth
-    /// ([`RayClip::thick`]). O(1).
+    /// ([`RayClip::thick`]), plus `2^-22 (m + g)` on each axis, where `m`
+    /// bounds the magnitude of every finite coordinate of the boxes whose
+    /// `sweep_aabb` entry the bound must stay below (`∞` when unknown: then
+    /// every box is entered at 0).
+    ///
+    /// Why the extra: `sweep_aabb` grows a box by `g` and rounds the grown
+    /// sides outward to `f32`, moving each by less than `2^-23 (m + g)`; a
+    /// bound for the box grown exactly by `g` can exceed its entry by that
+    /// much. With the extra, the thick ray covers the rounded box of every
+    /// box with coordinates up to `m`, so [`EntryBound::enter`] is at most
+    /// `sweep_aabb`'s `t0` on all of them. The first-hit searches need it:
+    /// [`sweep_sphere`]'s time is clamped to `sweep_aabb`'s entry of the
+    /// sphere's box, and a pruned node's bound must stay below it. (A
+    /// selection walk needs only "touches nothing", which `m = 0` gives.)
+    /// O(1).
     #[inline]
-    pub(crate) fn sweep(sweep: &SphereSweep) -> EntryBound {
+    pub(crate) fn sweep(sweep: &SphereSweep, m: f32) -> EntryBound {
         EntryBound {
             clip: sweep_ray(sweep)
+                .map(|(ray, g)| {
+                    // Rounded up (the factor exceeds the sum's rounding).
+                    let g = g.map(|g| widen(g + (m as f64 + g) * (1.0 / 4194304.0), true));
+                    (ray, g)
+                })
                 .filter(|(ray, g)| ray.origin.is_finite() && g.iter().all(|x| x.is_finite()))
                 .map(|(ray, g)| RayClip::thick(&ray, g)),
         }
     }
 
     /// A parameter at most the `t0` of [`ray_aabb`] (for a ray) or
-    /// [`sweep_aabb`] (for a sweep) on `b`, and `None` only when that is
-    /// `None` or the exact interval it rounds is empty. So a search that
-    /// skips a box entered after its best contact skips only what the exact
-    /// test would (and a little less).
+    /// [`sweep_aabb`] (for a sweep, on boxes with coordinates up to its `m`)
+    /// on `b`, and `None` only when the exact interval of `b` grown by the
+    /// sweep's growth is empty (so the cast touches nothing inside `b`). A
+    /// search that skips a box entered after its best contact skips only
+    /// what the exact test would (and a little less). Monotone in `b` (a
+    /// larger box is never entered later): the clip's roundings are.
     ///
     /// Why it is below: [`RayClip::thick`]'s interval contains the exact
-    /// interval of the box grown by the sweep's growth (which is what
-    /// `sweep_aabb` grows by, before rounding its box outward to `f32`), its
-    /// `t0` is then at most the exact entry, and rounded down to `f32` at
-    /// most that entry's `f32` floor, `ray_aabb`'s `t0`. Infinite sides stay
-    /// infinite; a NaN side is ignored, as in `clip`. Cost: 6 `f64`
+    /// interval of the box grown as [`EntryBound::sweep`] says, which
+    /// contains `sweep_aabb`'s rounded box; its `t0` is then at most that
+    /// box's exact entry, and rounded down to `f32` at most the entry's `f32`
+    /// floor, `sweep_aabb`'s (or for a ray `ray_aabb`'s) `t0`. Infinite sides
+    /// stay infinite; a NaN side is ignored, as in `clip`. Cost: 6 `f64`
     /// subtractions and products, no division. (Tested against the exact
     /// tests, including adversarial magnitudes.)
     #[inline(always)]

@@ -100,7 +100,8 @@ impl<T, S: Store> CellGrid<T, S> {
         };
         // Does the cast touch the spheres reported from `key` by a visit whose
         // ranges start at `from`?
-        let entry = cast.entry();
+        // Touch tests only (`is_some`): no magnitude needed.
+        let entry = cast.entry(0.0);
         let touches = |key: Key, from: Key| {
             let b = self.report_box(&KeyBox::single(key), &KeyBox::single(from), 2.0);
             entry.enter(&b.grown(extra)).is_some()

@@ -236,7 +236,7 @@ struct Loc {
 /// node and a range of objects at each level of its path: cache lines, not
 /// arithmetic, bound it. On W4 (100 000 static spheres, `proxima-bench w4`, a
 /// quiet run, BENCHMARKS.md) its sphere and box queries took 1.9× and 2.5× the
-/// time of rstar's bulk-loaded R-tree, while its rays took 0.94–0.96× (since
+/// time of rstar's bulk-loaded R-tree, while its rays took 0.82–0.96× (since
 /// casts test boxes with a bound prepared once per ray) and its frusta 0.9×.
 /// For that use, [`UniformGrid3d`](super::UniformGrid3d) (0.9–1.0× rstar
 /// on spheres and boxes) or [`LinearOctree`](super::LinearOctree) (frusta) fit

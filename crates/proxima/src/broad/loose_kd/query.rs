@@ -269,12 +269,15 @@ impl<T> LooseKdTree<T> {
         if self.root == NIL {
             return None;
         }
-        let entry = cast.entry();
+        let root = &self.nodes[self.root];
+        // The root's region holds every stored sphere's box: its magnitude
+        // bounds theirs (`Cast::entry`).
+        let region = self.region(root);
+        let entry = cast.entry(region.min.abs().max(region.max.abs()).max_element());
         let mut best: Option<RayHit> = None;
         let beyond = |best: &Option<RayHit>, t: f32| best.is_some_and(|b| t > b.t);
         let mut stack = FixedStack::<CastPending>::new();
-        let root = &self.nodes[self.root];
-        if let Some(t) = entry.enter(&self.region(root)) {
+        if let Some(t) = entry.enter(&region) {
             stack.push(CastPending {
                 node: self.root,
                 t,

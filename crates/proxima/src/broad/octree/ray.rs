@@ -26,8 +26,11 @@ impl<T> LinearOctree<T> {
         let mut best = None;
         if !self.objects.is_empty() {
             let n = &self.nodes[self.root];
-            let entry = cast.entry();
-            if let Some(t0) = entry.enter(&self.loose_of([0; 3], 0, n.max_extent)) {
+            // The root's loose box holds every stored sphere's box: its
+            // magnitude bounds theirs (`Cast::entry`).
+            let root = self.loose_of([0; 3], 0, n.max_extent);
+            let entry = cast.entry(root.min.abs().max(root.max.abs()).max_element());
+            if let Some(t0) = entry.enter(&root) {
                 self.first_node(self.root, [0; 3], 0, t0, cast, &entry, filter, &mut best);
             }
         }

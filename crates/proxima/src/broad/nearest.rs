@@ -168,7 +168,7 @@ pub(crate) fn finish(out: &mut Vec<Neighbor>, k: usize) {
 /// `h.partition_point(|e| Neighbor::precedes(e, n))` (tested), at about half
 /// its cost (callgrind W7, k = 100). O(log k + ties).
 #[inline]
-pub(crate) fn insertion_point(h: &[Neighbor], n: &Neighbor) -> usize {
+fn insertion_point(h: &[Neighbor], n: &Neighbor) -> usize {
     let mut i = h.partition_point(|e| e.distance < n.distance);
     while i < h.len() && h[i].distance == n.distance && Neighbor::order(&h[i], n).is_lt() {
         i += 1;

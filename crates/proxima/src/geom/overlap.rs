@@ -874,17 +874,16 @@ impl RayClip {
     /// imply `o` is outside the grown slab.
     #[inline]
     pub(crate) fn thick(ray: &Ray, g: [f64; 3]) -> RayClip {
-        let mut c = RayClip::new(ray);
-        for a in 0..3 {
-            // Rounded outward: a sum of two finite `f64`s below 2^200 is
-            // within a relative 2^-53 of the exact one, and the factor moves
-            // it by more than that, away from `o` (exact at 0: `o = ∓g`
-            // makes the sum exact by Sterbenz).
-            let (hi, lo) = (c.o[a] + g[a], c.o[a] - g[a]);
-            c.o_hi[a] = widen(hi, true);
-            c.o_lo[a] = widen(lo, false);
+        let c = RayClip::new(ray);
+        // Rounded outward: a sum of two finite `f64`s below 2^200 is within a
+        // relative 2^-53 of the exact one, and the factor moves it by more
+        // than that, up for `o + g` and down for `o - g` (a sum that rounds
+        // to 0 is exact).
+        RayClip {
+            o_hi: [0, 1, 2].map(|a| widen(c.o[a] + g[a], true)),
+            o_lo: [0, 1, 2].map(|a| widen(c.o[a] - g[a], false)),
+            ..c
         }
-        c
     }
 
     /// An `f64` interval `[t0, t1]` containing the exact parameter interval

@@ -553,6 +553,7 @@ fn exactly_empty(ray: &Ray, b: &Aabb) -> bool {
 
 /// [`exactly_empty`] for `b` grown by `g[a]` on each side of axis `a`
 /// (exactly: the grown sides are expansions).
+#[allow(clippy::needless_range_loop)] // indexes the ray, the box and `g` by axis
 fn exactly_empty_grown(ray: &Ray, b: &Aabb, g: [f64; 3]) -> bool {
     // (numerator, denominator) of each finite entry and exit parameter.
     let mut enter = vec![(Exp::of(0.0), 1.0f64)];
@@ -841,8 +842,16 @@ fn entry_bound_is_below_the_exact_entry() {
     let uniform = |rng: &mut Pcg64| Vec3::from(rng.gen::<[f32; 3]>().map(|x| 200.0 * x - 100.0));
     for k in 0..200_000 {
         let ordinary = k % 10 == 9;
-        let o = if ordinary { uniform(&mut rng) } else { cv(&mut rng) };
-        let mut d = if ordinary { uniform(&mut rng) } else { cv(&mut rng) };
+        let o = if ordinary {
+            uniform(&mut rng)
+        } else {
+            cv(&mut rng)
+        };
+        let mut d = if ordinary {
+            uniform(&mut rng)
+        } else {
+            cv(&mut rng)
+        };
         if k % 4 == 0 {
             d[rng.gen_range(0..3)] = 0.0;
         }
@@ -889,7 +898,11 @@ fn entry_bound_is_below_the_exact_entry() {
                     "k={k} {o} {d} {b:?}: touch bound misses"
                 );
             }
-            (EntryBound::sweep(&sw, m).enter(&b), sweep_aabb(&sw, &b), grown)
+            (
+                EntryBound::sweep(&sw, m).enter(&b),
+                sweep_aabb(&sw, &b),
+                grown,
+            )
         } else {
             if d == Vec3::ZERO {
                 d = Vec3::X;

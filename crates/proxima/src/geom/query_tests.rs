@@ -630,25 +630,8 @@ fn ray_clip_contains_the_exact_interval() {
         }
         let max_t = [f32::INFINITY, 1.0, coarse(&mut rng).abs()][k % 3];
         let ray = Ray::with_max_t(o, d, max_t);
-        let (mut lo, mut hi) = (cv(&mut rng), cv(&mut rng));
-        for a in 0..3 {
-            if lo[a] > hi[a] {
-                std::mem::swap(&mut lo[a], &mut hi[a]);
-            }
-            match rng.gen_range(0..8) {
-                0 => lo[a] = f32::NEG_INFINITY,
-                1 => hi[a] = f32::INFINITY,
-                2 => hi[a] = lo[a],
-                _ => {}
-            }
-        }
-        if k % 5 == 0 {
-            // A box touching the ray at one parameter: its corner on it.
-            let t = coarse(&mut rng).abs();
-            let p = o + d * t;
-            (lo, hi) = (p, p + cv(&mut rng).abs());
-        }
-        let b = Aabb::new(lo, hi);
+        let b = entry_box(&mut rng, o, d, k);
+        let (lo, hi) = (b.min, b.max);
         let exact = ray_aabb(&ray, &b);
         let clip = RayClip::new(&ray);
         let Some((c0, c1)) = clip.clip(&b) else {

@@ -1,7 +1,7 @@
 //! Queries ([sources: kd-query]: `TestIntersection`, generalized to any [`Selection`]) and the
 //! front-to-back first-hit ray search.
 
-use super::node::{FixedStack, NIL};
+use super::node::{FixedStack, Node, NIL};
 use super::store::CHUNK;
 use super::LooseKdTree;
 use crate::broad::filter::Admit;
@@ -130,13 +130,7 @@ impl<T> LooseKdTree<T> {
                         continue;
                     }
                 }
-                // The child's box, from the parent: one face moved to `m ∓ h`.
-                let mut cb = p.bbox;
-                if side == 1 {
-                    cb.min[a] = node.m - node.h;
-                } else {
-                    cb.max[a] = node.m + node.h;
-                }
+                let cb = child_box(node, &p.bbox, side);
                 let region = self.region_of_box(&cb);
                 if push(c, cb, query.classify_box(&region, p.mask), &mut stack) {
                     // Start loading the child now, so that the load overlaps the
@@ -293,19 +287,12 @@ impl<T> LooseKdTree<T> {
                 continue;
             }
             let mut next = [CastPending::default(); 2];
-            let a = node.axis as usize;
             for (side, e) in next.iter_mut().enumerate() {
                 let c = node.child[side];
                 if c == NIL {
                     continue;
                 }
-                // The child's box, from the parent: one face moved to `m ∓ h`.
-                let mut cb = p.bbox;
-                if side == 1 {
-                    cb.min[a] = node.m - node.h;
-                } else {
-                    cb.max[a] = node.m + node.h;
-                }
+                let cb = child_box(node, &p.bbox, side);
                 if let Some(t) = entry.enter(&self.region_of_box(&cb)) {
                     *e = CastPending {
                         node: c,
@@ -368,6 +355,20 @@ impl<T> LooseKdTree<T> {
             p = end;
         }
     }
+}
+
+/// The box of `node`'s child on `side`, from the node's box `bbox` (carried
+/// by the walk): one face moved to `m ∓ h` on the split axis (the boxes
+/// `validate` checks), so a walk reads no child before it visits it.
+#[inline(always)]
+fn child_box(node: &Node, bbox: &Aabb, side: usize) -> Aabb {
+    let (a, mut cb) = (node.axis as usize, *bbox);
+    if side == 1 {
+        cb.min[a] = node.m - node.h;
+    } else {
+        cb.max[a] = node.m + node.h;
+    }
+    cb
 }
 
 /// A node waiting in the first-hit search: its index, a lower bound on the

@@ -3,7 +3,7 @@
 //! [`Selection::selects`], so one traversal serves every query shape. Internal:
 //! users query with [`Query`](super::Query); the trait is sealed and hidden.
 
-use super::walk::Cast;
+use super::walk::{Cast, Contact};
 use crate::geom::overlap::{self, EntryBound};
 use crate::geom::{Aabb, Frustum, Ray, Relation, Sphere, SphereSweep};
 use crate::Result;
@@ -253,12 +253,14 @@ impl Selection for SphereSweep {
 /// direction and the growth computed once per walk, no division per box)
 /// instead of the exact [`overlap::ray_aabb`] / [`overlap::sweep_aabb`]:
 /// `None` there only where the exact test says `None` or the exact interval
-/// is empty, so a box holding a touched sphere is never `Outside`. What
+/// is empty, so a box holding a touched sphere is never `Outside`; its
+/// sphere tests are the cast's prepared ones ([`Cast::test`]). What
 /// [`super::walk::visit`] hands the indices for [`Query::Ray`](super::Query::Ray)
 /// and [`Query::Sweep`](super::Query::Sweep).
 pub(crate) struct Prepared<'a, C: Cast> {
     cast: &'a C,
     entry: EntryBound,
+    test: C::Test,
 }
 
 impl<'a, C: Cast> Prepared<'a, C> {
@@ -269,6 +271,7 @@ impl<'a, C: Cast> Prepared<'a, C> {
             cast,
             // Touch tests only (`Outside` = touches nothing): no magnitude.
             entry: cast.entry(0.0),
+            test: cast.test(),
         }
     }
 }
@@ -279,7 +282,7 @@ impl<C: Cast> Selection for Prepared<'_, C> {
     }
     #[inline]
     fn selects(&self, s: &Sphere) -> bool {
-        self.cast.selects(s)
+        self.test.touches(s)
     }
     #[inline]
     fn classify_box(&self, b: &Aabb, mask: u8) -> (Relation, u8) {

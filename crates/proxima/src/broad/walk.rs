@@ -14,7 +14,7 @@
 use super::nearest::{self, Nearest, Neighbor};
 use super::selection::Prepared;
 use super::{Filter, Query, RayHit, Selection};
-use crate::geom::overlap::EntryBound;
+use crate::geom::overlap::{EntryBound, SweepTest};
 use crate::geom::{overlap, Ray, Sphere, SphereSweep};
 use crate::{Handle, Result};
 use std::ops::ControlFlow;
@@ -97,9 +97,11 @@ pub(crate) trait Walk<T> {
 /// with a parameter of first contact. Written once here so that every index
 /// answers `ray_first` and `sweep_first` with one search each.
 pub(crate) trait Cast: Selection {
-    /// The parameter at which the cast first touches the closed sphere `s`,
-    /// or `None` ([`overlap::ray_sphere`], [`overlap::sweep_sphere`]).
-    fn contact(&self, s: &Sphere) -> Option<f32>;
+    /// The cast's sphere tests, prepared once per query.
+    type Test: Contact;
+    /// Prepares the sphere tests: what a search does once before testing
+    /// many spheres. O(1).
+    fn test(&self) -> Self::Test;
     /// The cast prepared for its search's box tests, over stored spheres
     /// whose bounding boxes have coordinates of magnitude at most `m`
     /// ([`EntryBound::sweep`]; `0` for a walk that needs only touch tests):
@@ -136,10 +138,45 @@ pub(crate) trait Cast: Selection {
     }
 }
 
-impl Cast for Ray {
+/// A cast's exact sphere tests, with whatever depends on the cast alone
+/// computed once ([`Cast::test`]): a sweep's pre-test terms
+/// ([`SweepTest`]); a ray needs nothing.
+pub(crate) trait Contact {
+    /// The parameter at which the cast first touches the closed sphere `s`,
+    /// or `None` ([`overlap::ray_sphere`], [`overlap::sweep_sphere`]).
+    fn contact(&self, s: &Sphere) -> Option<f32>;
+    /// Whether [`Contact::contact`] is `Some`, without computing it
+    /// ([`overlap::ray_touches_sphere`], [`overlap::sweep_touches_sphere`]).
+    fn touches(&self, s: &Sphere) -> bool;
+}
+
+impl Contact for Ray {
     #[inline]
     fn contact(&self, s: &Sphere) -> Option<f32> {
         overlap::ray_sphere(self, s)
+    }
+    #[inline]
+    fn touches(&self, s: &Sphere) -> bool {
+        overlap::ray_touches_sphere(self, s)
+    }
+}
+
+impl Contact for SweepTest {
+    #[inline]
+    fn contact(&self, s: &Sphere) -> Option<f32> {
+        SweepTest::contact(self, s)
+    }
+    #[inline]
+    fn touches(&self, s: &Sphere) -> bool {
+        SweepTest::touches(self, s)
+    }
+}
+
+impl Cast for Ray {
+    type Test = Ray;
+    #[inline]
+    fn test(&self) -> Ray {
+        *self
     }
     #[inline]
     fn entry(&self, _m: f32) -> EntryBound {
@@ -152,9 +189,10 @@ impl Cast for Ray {
 }
 
 impl Cast for SphereSweep {
+    type Test = SweepTest;
     #[inline]
-    fn contact(&self, s: &Sphere) -> Option<f32> {
-        overlap::sweep_sphere(self, s)
+    fn test(&self) -> SweepTest {
+        SweepTest::new(self)
     }
     #[inline]
     fn entry(&self, m: f32) -> EntryBound {
@@ -181,8 +219,9 @@ pub(crate) fn scan_first<T, I: Walk<T> + ?Sized, C: Cast>(
     filter: Option<Filter>,
 ) -> Option<RayHit> {
     let mut best: Option<RayHit> = None;
+    let test = cast.test();
     let _ = index.walk_filtered(cast, filter, |h, s, _| {
-        if let Some(t) = cast.contact(s) {
+        if let Some(t) = test.contact(s) {
             RayHit::offer(&mut best, t, h);
         }
         ControlFlow::Continue(())

@@ -922,3 +922,52 @@ fn entry_bound_is_below_the_exact_entry() {
     }
     assert!(met > 20_000 && close > 1_000, "{met} {close}");
 }
+
+/// `EntryBound::enter_octants` (the octree's children step) equals
+/// `EntryBound::enter` on each of its 8 boxes, bit for bit, for rays and
+/// sweeps (with and without a magnitude) on adversarial inputs: coarse
+/// coordinates with exact ties, zero direction components, infinite,
+/// degenerate and inverted halves, zero-length sweeps.
+#[test]
+fn entry_octants_equal_entry_per_box() {
+    let mut rng = Pcg64::seed_from_u64(67);
+    let mut some = 0u32;
+    for k in 0..50_000 {
+        let o = cv(&mut rng);
+        let mut d = cv(&mut rng);
+        if k % 4 == 0 {
+            d[rng.gen_range(0..3)] = 0.0;
+        }
+        let entry = if k % 2 == 0 {
+            if d == Vec3::ZERO {
+                d = Vec3::Y;
+            }
+            let max_t = [f32::INFINITY, 1.0, coarse(&mut rng).abs()][k % 3];
+            EntryBound::ray(&Ray::with_max_t(o, d, max_t))
+        } else {
+            let to = if k % 7 == 1 { o } else { o + d };
+            let sw = SphereSweep::new(o, to, coarse(&mut rng).abs());
+            if sw.validate().is_err() {
+                continue;
+            }
+            EntryBound::sweep(&sw, [0.0, coarse(&mut rng).abs()][k % 3 / 2])
+        };
+        // Two boxes from the adversarial generator lend each axis its halves.
+        let (b0, b1) = (entry_box(&mut rng, o, d, k), entry_box(&mut rng, o, d, k + 1));
+        let halves = [0, 1, 2].map(|a| [(b0.min[a], b0.max[a]), (b1.min[a], b1.max[a])]);
+        let got = entry.enter_octants(halves);
+        for (i, g) in got.iter().enumerate() {
+            let pick = |a: usize| halves[a][(i >> a) & 1];
+            let (x, y, z) = (pick(0), pick(1), pick(2));
+            let b = Aabb::new(Vec3::new(x.0, y.0, z.0), Vec3::new(x.1, y.1, z.1));
+            let want = entry.enter(&b);
+            assert_eq!(
+                g.map(f32::to_bits),
+                want.map(f32::to_bits),
+                "k={k} octant {i} {b:?}"
+            );
+            some += want.is_some() as u32;
+        }
+    }
+    assert!(some > 20_000, "too few entered boxes: {some}");
+}

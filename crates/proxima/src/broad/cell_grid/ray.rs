@@ -39,7 +39,7 @@ use super::keys::{Key, KeyBox, REL_PAD};
 use super::list::{CellEntry, Packed};
 use super::store::Store;
 use super::CellGrid;
-use crate::broad::walk::Cast;
+use crate::broad::walk::{Cast, Contact};
 use crate::broad::{Filter, RayHit};
 use crate::geom::{Aabb, Ray, Sphere};
 use crate::Handle;
@@ -407,8 +407,9 @@ impl<T, S: Store> CellGrid<T, S> {
     pub fn first_hit<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
         let admits = |slot: u32| filter.map_or(true, |f| f.interacts(self.filters[slot as usize]));
+        let test = cast.test();
         for &slot in &self.oversized {
-            if let Some(t) = cast.contact(&self.spheres[slot as usize]) {
+            if let Some(t) = test.contact(&self.spheres[slot as usize]) {
                 if admits(slot) {
                     RayHit::offer(&mut best, t, self.handle(slot));
                 }
@@ -416,7 +417,7 @@ impl<T, S: Store> CellGrid<T, S> {
         }
         let _ = self.walk_ray(cast, |s| match s {
             Step::Candidate(e) => {
-                if let Some(t) = cast.contact(&self.spheres[e.slot as usize]) {
+                if let Some(t) = test.contact(&self.spheres[e.slot as usize]) {
                     if admits(e.slot) {
                         RayHit::offer(&mut best, t, self.handle(e.slot));
                     }

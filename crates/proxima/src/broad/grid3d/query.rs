@@ -3,7 +3,7 @@
 
 use super::cells::Geometry;
 use super::UniformGrid3d;
-use crate::broad::walk::Cast;
+use crate::broad::walk::{Cast, Contact};
 use crate::broad::{Filter, RayHit, Selection};
 use crate::geom::exact::round_down_f32;
 use crate::geom::overlap::RayClip;
@@ -271,9 +271,10 @@ impl<T> UniformGrid3d<T> {
     /// the answer is the scan's.
     pub(super) fn first_cast<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
+        let test = cast.test();
         let offer = |best: &mut Option<RayHit>, slot: u32| {
             let s = &self.spheres[slot as usize];
-            if let Some(t) = cast.contact(s) {
+            if let Some(t) = test.contact(s) {
                 if filter.map_or(true, |f| f.interacts(self.filters[slot as usize])) {
                     RayHit::offer(best, t, self.resolve(slot).0);
                 }

@@ -5,7 +5,7 @@ use super::node::{FixedStack, Node, NIL};
 use super::store::CHUNK;
 use super::LooseKdTree;
 use crate::broad::filter::Admit;
-use crate::broad::walk::Cast;
+use crate::broad::walk::{Cast, Contact};
 use crate::broad::{Filter, RayHit, Selection};
 use crate::geom::overlap::EntryBound;
 use crate::geom::{Aabb, Frustum, Relation, Sphere};
@@ -268,6 +268,7 @@ impl<T> LooseKdTree<T> {
         // bounds theirs (`Cast::entry`).
         let region = self.region(root);
         let entry = cast.entry(region.min.abs().max(region.max.abs()).max_element());
+        let test = cast.test();
         let mut best: Option<RayHit> = None;
         let beyond = |best: &Option<RayHit>, t: f32| best.is_some_and(|b| t > b.t);
         let mut stack = FixedStack::<CastPending>::new();
@@ -301,7 +302,7 @@ impl<T> LooseKdTree<T> {
                     };
                 }
             }
-            self.first_in_node(node.range(), node.loose, cast, &entry, filter, &mut best);
+            self.first_in_node(node.range(), node.loose, &test, &entry, filter, &mut best);
             // Push the farther first so the nearer is popped first.
             if next[0].t < next[1].t {
                 next.swap(0, 1);
@@ -320,11 +321,11 @@ impl<T> LooseKdTree<T> {
     /// `best` (or never) is skipped unread. Short ranges and the objects of
     /// a `loose` node are tested one by one, as in [`Self::scan`].
     #[inline(always)]
-    fn first_in_node<C: Cast>(
+    fn first_in_node<X: Contact>(
         &self,
         range: Range<usize>,
         loose: bool,
-        cast: &C,
+        test: &X,
         entry: &EntryBound,
         filter: Option<Filter>,
         best: &mut Option<RayHit>,
@@ -344,7 +345,7 @@ impl<T> LooseKdTree<T> {
                 }
             }
             for (q, s) in (p..end).zip(&self.store.sphere[p..end]) {
-                if let Some(t) = cast.contact(s).filter(|&t| !best.is_some_and(|b| t > b.t)) {
+                if let Some(t) = test.contact(s).filter(|&t| !best.is_some_and(|b| t > b.t)) {
                     let (h, of, _) = self.store.full(q);
                     if filter.is_some_and(|f| !f.interacts(of)) {
                         continue;

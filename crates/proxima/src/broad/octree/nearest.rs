@@ -187,16 +187,8 @@ impl<T> LinearOctree<T> {
         d: u32,
         q: &Nearest,
     ) -> ([f64; 2], [f64; 2], [f64; 2]) {
-        let (size, grow) = (self.cell_size[d as usize + 1], n.max_extent + self.slack);
-        let gap = |a: usize| {
-            let lo = self.cube.min[a] + (c[a] * 2) as f32 * size;
-            let hi = self.cube.min[a] + (c[a] * 2 + 1) as f32 * size;
-            let p = q.point[a];
-            [
-                overlap::axis_gap_sq(p, lo - grow, (lo + size) + grow),
-                overlap::axis_gap_sq(p, hi - grow, (hi + size) + grow),
-            ]
-        };
+        let halves = self.child_halves(n, c, d);
+        let gap = |a: usize| halves[a].map(|(lo, hi)| overlap::axis_gap_sq(q.point[a], lo, hi));
         (gap(0), gap(1), gap(2))
     }
 

@@ -119,6 +119,24 @@ impl<T> LinearOctree<T> {
         self.cell_of(c, d).grown(max_extent + self.slack)
     }
 
+    /// Loose boxes of the children of inner node `n` (at `c`, depth `d`)
+    /// without reading them: their cells grown by `n`'s extent (never below
+    /// a child's, so every sphere below each child is still inside). Per
+    /// axis `a`, the low and high halves of `n`'s cell so grown; child `k`
+    /// spans `halves[a][(k >> a) & 1]` (the octant order of
+    /// `query::child_coords`). The same `f32` sides as [`Self::loose_of`]
+    /// with `n`'s extent computes for each child.
+    #[inline(always)]
+    pub(super) fn child_halves(&self, n: &Node, c: [u32; 3], d: u32) -> [[(f32, f32); 2]; 3] {
+        let (size, grow) = (self.cell_size[d as usize + 1], n.max_extent + self.slack);
+        [0, 1, 2].map(|a| {
+            [0, 1].map(|h| {
+                let lo = self.cube.min[a] + (c[a] * 2 + h) as f32 * size;
+                (lo - grow, (lo + size) + grow)
+            })
+        })
+    }
+
     /// Placement of a sphere: the depth-21 key of its clamped centre and its extent.
     #[inline]
     pub(super) fn placement(&self, s: &Sphere) -> (u64, f32) {

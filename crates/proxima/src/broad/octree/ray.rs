@@ -5,7 +5,7 @@
 use super::node::NONE;
 use super::query::child_coords;
 use super::LinearOctree;
-use crate::broad::walk::Cast;
+use crate::broad::walk::{Cast, Contact};
 use crate::broad::{Filter, RayHit};
 use crate::geom::overlap::EntryBound;
 
@@ -31,20 +31,21 @@ impl<T> LinearOctree<T> {
             let root = self.loose_of([0; 3], 0, n.max_extent);
             let entry = cast.entry(root.min.abs().max(root.max.abs()).max_element());
             if let Some(t0) = entry.enter(&root) {
-                self.first_node(self.root, [0; 3], 0, t0, cast, &entry, filter, &mut best);
+                let test = cast.test();
+                self.first_node(self.root, [0; 3], 0, t0, &test, &entry, filter, &mut best);
             }
         }
         best
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn first_node<C: Cast>(
+    fn first_node<X: Contact>(
         &self,
         i: u32,
         c: [u32; 3],
         d: u32,
         t0: f32,
-        cast: &C,
+        test: &X,
         entry: &EntryBound,
         filter: Option<Filter>,
         best: &mut Option<RayHit>,
@@ -60,7 +61,7 @@ impl<T> LinearOctree<T> {
         }
         if n.leaf {
             for it in &n.items {
-                if let Some(t) = cast.contact(&it.sphere) {
+                if let Some(t) = test.contact(&it.sphere) {
                     if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
                         RayHit::offer(best, t, it.handle);
                     }
@@ -68,22 +69,23 @@ impl<T> LinearOctree<T> {
             }
             return;
         }
+        // The children's boxes from this node's extent: 12 slab parameters
+        // for all 8, and no child node read before it is entered.
+        let enters = entry.enter_octants(self.child_halves(n, c, d));
         let mut order = [(0.0f32, 0u32, [0u32; 3]); 8];
         let mut m = 0;
-        for (k, &ch) in n.children.iter().enumerate() {
+        for (k, (&ch, ct0)) in n.children.iter().zip(enters).enumerate() {
             if ch == NONE {
                 continue;
             }
-            let cc = child_coords(c, k);
-            let loose = self.loose_of(cc, d + 1, self.nodes[ch].max_extent);
-            if let Some(ct0) = entry.enter(&loose) {
-                order[m] = (ct0, ch, cc);
+            if let Some(ct0) = ct0 {
+                order[m] = (ct0, ch, child_coords(c, k));
                 m += 1;
             }
         }
         order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         for &(ct0, ch, cc) in &order[..m] {
-            self.first_node(ch, cc, d + 1, ct0, cast, entry, filter, best);
+            self.first_node(ch, cc, d + 1, ct0, test, entry, filter, best);
         }
     }
 }

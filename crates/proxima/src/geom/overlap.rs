@@ -662,7 +662,8 @@ impl EntryBound {
         let Some(clip) = &self.clip else {
             return [Some(0.0); 8];
         };
-        clip.clip_octants(halves).map(|c| c.map(|(t0, _)| round_down(t0)))
+        clip.clip_octants(halves)
+            .map(|c| c.map(|(t0, _)| round_down(t0)))
     }
 }
 
@@ -992,11 +993,7 @@ impl RayClip {
     pub(crate) fn clip_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [Option<(f64, f64)>; 8] {
         let slabs = [0, 1, 2].map(|a| halves[a].map(|(lo, hi)| self.slab(a, lo, hi)));
         std::array::from_fn(|k| {
-            self.finish([
-                slabs[0][k & 1]?,
-                slabs[1][(k >> 1) & 1]?,
-                slabs[2][k >> 2]?,
-            ])
+            self.finish([slabs[0][k & 1]?, slabs[1][(k >> 1) & 1]?, slabs[2][k >> 2]?])
         })
     }
 

@@ -953,7 +953,10 @@ fn entry_octants_equal_entry_per_box() {
             EntryBound::sweep(&sw, [0.0, coarse(&mut rng).abs()][k % 3 / 2])
         };
         // Two boxes from the adversarial generator lend each axis its halves.
-        let (b0, b1) = (entry_box(&mut rng, o, d, k), entry_box(&mut rng, o, d, k + 1));
+        let (b0, b1) = (
+            entry_box(&mut rng, o, d, k),
+            entry_box(&mut rng, o, d, k + 1),
+        );
         let halves = [0, 1, 2].map(|a| [(b0.min[a], b0.max[a]), (b1.min[a], b1.max[a])]);
         let got = entry.enter_octants(halves);
         for (i, g) in got.iter().enumerate() {

@@ -178,14 +178,12 @@ impl<T> LooseKdTree<T> {
     }
 
     /// Reports the objects at positions `range` (one node's) that `query`
-    /// selects, chunk by chunk: a chunk whose bound (`store.rs`, plus the slack
-    /// `eps`) the query classifies `Outside` is skipped unread, one it classifies
-    /// `Inside` is reported without tests, the others are tested sphere by
-    /// sphere. `mask` is the node's frustum plane mask: the masked-off planes
-    /// contain the node's region, hence its objects, even where a chunk's bound
-    /// also covers a neighbouring range. Short ranges are tested directly (a
-    /// chunk test costs about as much as two sphere tests), and so are the
-    /// objects of a `loose` node (its bounds may miss moved objects).
+    /// selects, chunk by chunk ([`Self::chunks`]): a chunk whose bound the
+    /// query classifies `Outside` is skipped unread, one it classifies
+    /// `Inside` is reported without tests, the others (and the parts without
+    /// a bound) are tested sphere by sphere. `mask` is the node's frustum
+    /// plane mask: the masked-off planes contain the node's region, hence its
+    /// objects, even where a chunk's bound also covers a neighbouring range.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn scan<Q: Selection + ?Sized, A: Admit>(
@@ -197,30 +195,43 @@ impl<T> LooseKdTree<T> {
         admit: A,
         f: &mut impl FnMut(Handle, &Sphere, &T) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let mut p = range.start;
-        while p < range.end {
-            let end = ((p / CHUNK + 1) * CHUNK).min(range.end);
-            if !loose && end - p > 2 {
-                let c = &self.store.chunk[p / CHUNK];
-                let e = Vec3::splat(self.eps);
-                let b = Aabb::new(c.min - e, c.max + e);
-                match query.classify_box(&b, mask).0 {
-                    Relation::Outside => {
-                        p = end;
-                        continue;
-                    }
-                    Relation::Inside => {
-                        self.report_all(p..end, admit, f)?;
-                        p = end;
-                        continue;
-                    }
-                    Relation::Intersecting => {}
-                }
+        for (part, bound) in self.chunks(range, loose) {
+            match bound.map(|b| query.classify_box(&b, mask).0) {
+                Some(Relation::Outside) => {}
+                Some(Relation::Inside) => self.report_all(part, admit, f)?,
+                _ => self.test_each(part, query, admit, f)?,
             }
-            self.test_each(p..end, query, admit, f)?;
-            p = end;
         }
         ControlFlow::Continue(())
+    }
+
+    /// The positions `range` (one node's) cut at chunk borders, each part
+    /// with its chunk's bound (`store.rs`, plus the slack `eps`) when that
+    /// bound is worth a box test: not for parts of up to two objects (a
+    /// chunk test costs about as much as two sphere tests), nor for the
+    /// objects of a `loose` node (its bounds may miss moved objects). The
+    /// one chunk loop of the selection scan and the first-hit search.
+    #[inline(always)]
+    fn chunks(
+        &self,
+        range: Range<usize>,
+        loose: bool,
+    ) -> impl Iterator<Item = (Range<usize>, Option<Aabb>)> + '_ {
+        let e = Vec3::splat(self.eps);
+        let mut p = range.start;
+        std::iter::from_fn(move || {
+            if p >= range.end {
+                return None;
+            }
+            let end = ((p / CHUNK + 1) * CHUNK).min(range.end);
+            let bound = (!loose && end - p > 2).then(|| {
+                let c = &self.store.chunk[p / CHUNK];
+                Aabb::new(c.min - e, c.max + e)
+            });
+            let part = p..end;
+            p = end;
+            Some((part, bound))
+        })
     }
 
     /// Reports the objects at positions `range` that `query` selects, testing
@@ -318,8 +329,8 @@ impl<T> LooseKdTree<T> {
 
     /// Offers the contacts of the objects at positions `range` (one node's)
     /// to `best`, chunk by chunk: a chunk whose bound the cast enters after
-    /// `best` (or never) is skipped unread. Short ranges and the objects of
-    /// a `loose` node are tested one by one, as in [`Self::scan`].
+    /// `best` (or never) is skipped unread; parts without a bound
+    /// ([`Self::chunks`]) are tested one by one.
     #[inline(always)]
     fn first_in_node<X: Contact>(
         &self,
@@ -330,21 +341,14 @@ impl<T> LooseKdTree<T> {
         filter: Option<Filter>,
         best: &mut Option<RayHit>,
     ) {
-        let mut p = range.start;
-        while p < range.end {
-            let end = ((p / CHUNK + 1) * CHUNK).min(range.end);
-            if !loose && end - p > 2 {
-                let c = &self.store.chunk[p / CHUNK];
-                let e = Vec3::splat(self.eps);
-                match entry.enter(&Aabb::new(c.min - e, c.max + e)) {
+        for (part, bound) in self.chunks(range, loose) {
+            if let Some(b) = bound {
+                match entry.enter(&b) {
                     Some(t) if !best.is_some_and(|b| t > b.t) => {}
-                    _ => {
-                        p = end;
-                        continue;
-                    }
+                    _ => continue,
                 }
             }
-            for (q, s) in (p..end).zip(&self.store.sphere[p..end]) {
+            for (q, s) in part.clone().zip(&self.store.sphere[part]) {
                 if let Some(t) = test.contact(s).filter(|&t| !best.is_some_and(|b| t > b.t)) {
                     let (h, of, _) = self.store.full(q);
                     if filter.is_some_and(|f| !f.interacts(of)) {
@@ -353,7 +357,6 @@ impl<T> LooseKdTree<T> {
                     RayHit::offer(best, t, h);
                 }
             }
-            p = end;
         }
     }
 }

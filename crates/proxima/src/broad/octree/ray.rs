@@ -18,9 +18,12 @@ const PRUNE_MARGIN: f32 = 1e-4;
 
 impl<T> LinearOctree<T> {
     /// The contact of a ray or sweep with the smallest `(t, handle)`; children
-    /// are visited in order of their loose boxes' entry bound
-    /// ([`Cast::entry`]). No allocation (≤ 8 children sorted on the stack per
-    /// level). Objects whose filter does not interact with `filter` are
+    /// are visited in order of the entry bound ([`Cast::entry`]) of their
+    /// cells grown by the parent's extent (`child_halves`: all 8 from 12 slab
+    /// parameters, [`EntryBound::enter_octants`], and no child read before it
+    /// is entered; callgrind, W8 first hit: 21.4k → 16.7k instructions a
+    /// sweep with the prepared sweep test). No allocation (≤ 8 children
+    /// sorted on the stack per level). Objects whose filter does not interact with `filter` are
     /// skipped at the candidate.
     pub(super) fn first_tree<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best = None;

@@ -241,8 +241,10 @@ fn sweep_hits<T, I: SpatialIndex<T> + ?Sized>(
     filter: Option<Filter>,
 ) -> Result<Vec<SweepHit>> {
     let mut hits = Vec::new();
+    // The sweep's own terms once, not once per hit.
+    let test = overlap::SweepTest::new(sweep);
     let _ = index.visit(&Query::Sweep(*sweep), filter, &mut |h, s, _| {
-        if let Some(t) = overlap::sweep_sphere(sweep, s) {
+        if let Some(t) = test.contact(s) {
             hits.push(RayHit { handle: h, t });
         }
         ControlFlow::Continue(())

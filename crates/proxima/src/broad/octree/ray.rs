@@ -23,8 +23,8 @@ impl<T> LinearOctree<T> {
     /// parameters, [`EntryBound::enter_octants`], and no child read before it
     /// is entered; callgrind, W8 first hit: 21.4k → 16.7k instructions a
     /// sweep with the prepared sweep test). No allocation (≤ 8 children
-    /// sorted on the stack per level). Objects whose filter does not interact with `filter` are
-    /// skipped at the candidate.
+    /// sorted on the stack per level). Objects whose filter does not interact
+    /// with `filter` are skipped at the candidate.
     pub(super) fn first_tree<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best = None;
         if !self.objects.is_empty() {

@@ -713,9 +713,17 @@ fn outward_box(s: &Sphere) -> Aabb {
 /// `f32::MAX` round to `f32::MAX` or `∞` as IEEE rounding says.
 #[inline]
 pub fn point_sphere_distance(p: Vec3, s: &Sphere) -> f32 {
-    let (a, c) = (d3(p), d3(s.center));
-    let diff = [0, 1, 2].map(|i| a[i] - c[i]);
-    let dist = dot(diff, diff).sqrt();
+    point_sphere_distance_given_sq(p, s, point_point_distance_sq(p, s.center))
+}
+
+/// [`point_sphere_distance`] when the caller already holds
+/// `s2 = `[`point_point_distance_sq`]`(p, s.center)` (the k-nearest searches
+/// compute it for their pruning test first): the same value, bit for bit,
+/// without computing the squared distance twice. `s2` must be exactly that
+/// function's value, as the error bound below is derived from it. O(1).
+#[inline]
+pub(crate) fn point_sphere_distance_given_sq(p: Vec3, s: &Sphere, s2: f64) -> f32 {
+    let dist = s2.sqrt();
     let r = s.radius as f64;
     let v = dist - r;
     // Each difference rounds once, squares and sums three times, the root
@@ -726,10 +734,23 @@ pub fn point_sphere_distance(p: Vec3, s: &Sphere) -> f32 {
         return 0.0;
     }
     let y = (v as f32).max(0.0);
-    if v - err > rounding_below(y) && v + err < rounding_above(y) {
+    // The rounding boundaries around `y`: for a positive `y` below `f32::MAX`
+    // its neighbours are one bit pattern away (the common case, no branches
+    // of `rounding_below` / `rounding_above`); both forms give the same values.
+    let (below, above) = if y > 0.0 && y < f32::MAX {
+        let b = y.to_bits();
+        let yd = y as f64;
+        (
+            (yd + f32::from_bits(b - 1) as f64) * 0.5,
+            (yd + f32::from_bits(b + 1) as f64) * 0.5,
+        )
+    } else {
+        (rounding_below(y), rounding_above(y))
+    };
+    if v - err > below && v + err < above {
         return y;
     }
-    distance_rounded_exactly(a, c, r, v, err)
+    distance_rounded_exactly(d3(p), d3(s.center), r, v, err)
 }
 
 /// The midpoint between the non-negative `f32` `y` and the next one up (exact
@@ -814,6 +835,18 @@ pub fn point_point_distance_sq(p: Vec3, c: Vec3) -> f64 {
     let (a, c) = (d3(p), d3(c));
     let diff = [0, 1, 2].map(|i| a[i] - c[i]);
     dot(diff, diff)
+}
+
+/// An `f32` at least the correctly rounded distance `|c - p|`, given
+/// `s2 = `[`point_point_distance_sq`]`(p, c)`: `s2` is within `3u` relative
+/// of `|c - p|²` and the root adds half an ulp, so `sqrt(s2)·(1 + 1e-12)` is
+/// above the exact distance, and rounding it up keeps it above the correctly
+/// rounded one (rounding is monotone). `∞` beyond `f32::MAX`. The k-nearest
+/// searches' early bound from a first group of candidates
+/// (`KBest::tighten_by_centres`). O(1).
+#[inline]
+pub(crate) fn distance_at_most_from_sq(s2: f64) -> f32 {
+    -round_down(-(s2.sqrt() * (1.0 + 1e-12)))
 }
 
 /// [`point_point_distance_sq`] from `p` to the closest point of the closed

@@ -24,6 +24,11 @@ use std::collections::BinaryHeap;
 /// candidate insertions fell 23% (callgrind) and the time ~10%.
 const BEST_FIRST_MIN_K: usize = 32;
 
+/// The largest leaf whose items seed the candidate bound
+/// (`KBest::tighten_by_centres`); a leaf only exceeds `max_per_leaf` at the
+/// depth cap.
+const SEED_MAX: usize = 64;
+
 /// A node waiting in the best-first search: the squared distance from the
 /// query point to its box (the heap's key, smallest first), the node, its
 /// cell coordinates and depth.
@@ -75,8 +80,13 @@ impl<T> LinearOctree<T> {
     /// the rounded distances are monotone, so a pruned subtree holds nothing
     /// that could have entered and the answer is brute force's, bit for bit.
     /// Candidates are tested the same way before their exact distance
-    /// (`Metric::distance_within`). Octants are searched nearest first (at
-    /// most 8 sorted on the stack per level), or from
+    /// (`Metric::distance_within`). The first leaf reached bounds the answer
+    /// from its items' centre distances before it offers any
+    /// (`KBest::tighten_by_centres`; unfiltered queries), so later leaves
+    /// are pruned against a near-final bound and few candidates are
+    /// inserted only to be evicted. Octants are searched nearest first (at
+    /// most 8 sorted on the stack per level, the rest skipped at the first
+    /// one beyond the bound), or from
     /// `BEST_FIRST_MIN_K` answers on all pending nodes nearest first (a
     /// per-thread frontier heap). The filter is checked at each
     /// candidate that could enter. No allocation once `out` holds `k` entries.
@@ -155,6 +165,15 @@ impl<T> LinearOctree<T> {
     /// at k = 10 (callgrind, W7 points).
     #[inline(always)]
     fn offer_leaf(&self, n: &Node, q: &Nearest, filter: Option<Filter>, best: &mut KBest<'_>) {
+        // The first leaf reached with enough items (unfiltered queries) bounds
+        // the answer before anything is offered: see `KBest::tighten_by_centres`.
+        if best.is_empty() && filter.is_none() && n.items.len() <= SEED_MAX {
+            let mut s2 = [0.0f64; SEED_MAX];
+            for (d, it) in s2.iter_mut().zip(&n.items) {
+                *d = overlap::point_point_distance_sq(q.point, it.sphere.center);
+            }
+            best.tighten_by_centres(&mut s2[..n.items.len()]);
+        }
         for it in &n.items {
             let Some(distance) = q.metric.distance_within(q.point, &it.sphere, best) else {
                 continue;
@@ -260,6 +279,11 @@ impl<T> LinearOctree<T> {
             order[i] = e;
         }
         for &(dc, ch, cc) in &order[..m] {
+            // Sorted nearest first: once one child lies beyond the bound
+            // (which the earlier ones may have lowered), so do the rest.
+            if best.exceeds_sq(dc) {
+                break;
+            }
             self.nearest_node(ch, cc, d + 1, dc, q, filter, best);
         }
     }

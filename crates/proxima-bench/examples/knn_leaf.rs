@@ -10,16 +10,8 @@ use proxima::broad::SpatialIndex;
 use proxima::broad::{LinearOctree, Nearest, Neighbor, OctreeConfig, SceneHint};
 use proxima::geom::Sphere;
 use proxima::glam::Vec3;
+use rand::{Rng, SeedableRng};
 use std::time::Instant;
-
-fn rng(mut s: u64) -> impl FnMut() -> f32 {
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().skip(1).collect();
@@ -30,9 +22,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let k: usize = a[1].parse()?;
     let m: usize = a[2].parse()?;
     let side = 4.0 * (n as f32).cbrt();
-    let mut r = rng(7);
-    let points: Vec<Vec3> = (0..n).map(|_| Vec3::new(r(), r(), r()) * side).collect();
-    let queries: Vec<Vec3> = (0..m).map(|_| Vec3::new(r(), r(), r()) * side).collect();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+    let mut r = || Vec3::new(rng.gen(), rng.gen(), rng.gen()) * side;
+    let points: Vec<Vec3> = (0..n).map(|_| r()).collect();
+    let queries: Vec<Vec3> = (0..m).map(|_| r()).collect();
     let hint = SceneHint::from_spheres(points.iter().map(|&c| Sphere::new(c, 0.0)), n);
     for leaf in a[3..].iter().map(|s| s.parse::<u32>()) {
         let leaf = leaf?;

@@ -734,20 +734,7 @@ pub(crate) fn point_sphere_distance_given_sq(p: Vec3, s: &Sphere, s2: f64) -> f3
         return 0.0;
     }
     let y = (v as f32).max(0.0);
-    // The rounding boundaries around `y`: for a positive `y` below `f32::MAX`
-    // its neighbours are one bit pattern away (the common case, no branches
-    // of `rounding_below` / `rounding_above`); both forms give the same values.
-    let (below, above) = if y > 0.0 && y < f32::MAX {
-        let b = y.to_bits();
-        let yd = y as f64;
-        (
-            (yd + f32::from_bits(b - 1) as f64) * 0.5,
-            (yd + f32::from_bits(b + 1) as f64) * 0.5,
-        )
-    } else {
-        (rounding_below(y), rounding_above(y))
-    };
-    if v - err > below && v + err < above {
+    if v - err > rounding_below(y) && v + err < rounding_above(y) {
         return y;
     }
     distance_rounded_exactly(d3(p), d3(s.center), r, v, err)
@@ -758,22 +745,28 @@ pub(crate) fn point_sphere_distance_given_sq(p: Vec3, s: &Sphere, s2: f64) -> f3
 /// round to `y` or lower.
 #[inline]
 fn rounding_above(y: f32) -> f64 {
-    let next = if y == f32::MAX {
-        2f64.powi(128)
+    // A non-negative finite `f32`'s next one up is one bit pattern away
+    // (`-0.0` is taken as `+0.0`, whose pattern is 0); from `f32::MAX` on
+    // (and for `∞`, where the midpoint stays `∞`) `2^128` stands for it.
+    let next = if y < f32::MAX {
+        let b = if y == 0.0 { 0 } else { y.to_bits() };
+        f32::from_bits(b + 1) as f64
     } else {
-        -step_down(-y) as f64
+        2f64.powi(128)
     };
     (y as f64 + next) * 0.5
 }
 
 /// The midpoint between the non-negative `f32` `y` and the next one down;
-/// `-∞` for `y = 0` (negative values clamp to 0).
+/// `-∞` for `y = 0` (negative values clamp to 0). A positive `y`'s next one
+/// down is one bit pattern away (`f32::MAX` below `∞`, whose midpoint
+/// stays `∞`).
 #[inline]
 fn rounding_below(y: f32) -> f64 {
     if y == 0.0 {
         f64::NEG_INFINITY
     } else {
-        (y as f64 + step_down(y) as f64) * 0.5
+        (y as f64 + f32::from_bits(y.to_bits() - 1) as f64) * 0.5
     }
 }
 
@@ -1357,6 +1350,74 @@ pub fn distance_squared(a: Vec3, b: Vec3) -> f32 {
 
 #[cfg(test)]
 mod tests {
+
+    /// The rounding boundaries from bit patterns equal the midpoints with the
+    /// neighbouring `f32`s (from `exact::f32_down` and `f64` arithmetic) at
+    /// every edge: `±0`, the smallest subnormal, the subnormal/normal seam,
+    /// powers of two, `f32::MAX` (whose next one up is `2^128`) and `∞`, and
+    /// on 10,000 random bit patterns.
+    #[test]
+    fn rounding_boundaries_are_the_midpoints_with_the_neighbours() {
+        let up = |y: f32| {
+            if y == f32::MAX || y == f32::INFINITY {
+                2f64.powi(128)
+            } else {
+                -step_down(-y) as f64
+            }
+        };
+        let check = |y: f32| {
+            let yd = if y == 0.0 { 0.0 } else { y as f64 };
+            let above = if y == f32::INFINITY {
+                f64::INFINITY
+            } else {
+                (yd + up(y)) * 0.5
+            };
+            assert_eq!(rounding_above(y), above, "above {y:e}");
+            let below = if y == 0.0 {
+                f64::NEG_INFINITY
+            } else {
+                (yd + step_down(y) as f64) * 0.5
+            };
+            assert_eq!(rounding_below(y), below, "below {y:e}");
+            if y != f32::INFINITY {
+                assert!(rounding_below(y) < yd && yd < rounding_above(y), "{y:e}");
+            }
+        };
+        let tiny = f32::from_bits(1);
+        for y in [
+            0.0,
+            -0.0,
+            tiny,
+            f32::from_bits(2),
+            f32::MIN_POSITIVE,
+            step_down(f32::MIN_POSITIVE),
+            0.5,
+            1.0,
+            step_down(1.0),
+            3.0,
+            f32::MAX,
+            step_down(f32::MAX),
+            f32::INFINITY,
+        ] {
+            check(y);
+        }
+        assert_eq!(rounding_above(0.0), tiny as f64 / 2.0);
+        assert_eq!(rounding_above(-0.0), tiny as f64 / 2.0);
+        assert_eq!(rounding_above(1.0), 1.0 + 2f64.powi(-24));
+        assert_eq!(rounding_below(1.0), 1.0 - 2f64.powi(-25));
+        assert_eq!(
+            rounding_above(f32::MAX),
+            (f32::MAX as f64 + 2f64.powi(128)) * 0.5
+        );
+        let mut st = 0x9E37_79B9_7F4A_7C15u64;
+        for _ in 0..10_000 {
+            st ^= st << 13;
+            st ^= st >> 7;
+            st ^= st << 17;
+            let y = f32::from_bits((st >> 33) as u32 % f32::INFINITY.to_bits());
+            check(y);
+        }
+    }
 
     #[test]
     fn axis_gaps_sum_to_the_box_distance_bit_for_bit() {

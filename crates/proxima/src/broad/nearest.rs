@@ -48,11 +48,34 @@ impl Metric {
     #[inline]
     pub(crate) fn distance_within(self, point: Vec3, s: &Sphere, best: &KBest<'_>) -> Option<f32> {
         let s2 = overlap::point_point_distance_sq(point, s.center);
-        let out = match self {
+        self.distance_within_given_sq(point, s, s2, best)
+    }
+
+    /// Whether `s`, whose squared centre distance from the query point is
+    /// `s2` ([`overlap::point_point_distance_sq`]), surely cannot enter
+    /// `best` in this metric ([`KBest::exceeds`]): the pruning half of
+    /// [`Metric::distance_within`], for searches that test a whole group of
+    /// candidates before computing any distance. O(1), no branch.
+    #[inline]
+    pub(crate) fn excluded(self, s2: f64, s: &Sphere, best: &KBest<'_>) -> bool {
+        match self {
             Metric::Surface => best.exceeds(s2, s.radius),
             Metric::Center => best.exceeds_sq(s2),
-        };
-        if out {
+        }
+    }
+
+    /// [`Metric::distance_within`] when the caller already holds `s2 =`
+    /// [`overlap::point_point_distance_sq`]`(point, s.center)`: the same
+    /// value without computing it twice. O(1).
+    #[inline]
+    pub(crate) fn distance_within_given_sq(
+        self,
+        point: Vec3,
+        s: &Sphere,
+        s2: f64,
+        best: &KBest<'_>,
+    ) -> Option<f32> {
+        if self.excluded(s2, s, best) {
             return None;
         }
         let distance = match self {
@@ -193,6 +216,11 @@ pub(crate) const SORTED_MAX_K: usize = 256;
 /// (`O(k)` comparisons, no call); above it by a binary search and a move.
 const LINEAR_MAX_K: usize = 32;
 
+/// The largest group [`KBest::tighten_by_centres`] takes (the octree's first
+/// leaf; a leaf only exceeds its `max_per_leaf` at the depth cap), so that
+/// its selection needs no allocation.
+pub(crate) const SEED_MAX: usize = 64;
+
 /// The `k` best candidates seen so far inside the caller's output buffer: the
 /// bounded candidate set of the best-first and branch-and-bound searches. For
 /// `k <=` [`SORTED_MAX_K`] the buffer is kept in answer order
@@ -283,39 +311,43 @@ impl<'a> KBest<'a> {
     /// enter. The searches then offer only about `k` candidates from the
     /// first leaf instead of every one that beats a still loose bound
     /// (octree, 100k points, k = 10: 17.1 insertions a query instead of
-    /// 24.6, callgrind on `examples/knn_leaf`). May reorder `s2`. O(len · k)
-    /// for `k <=` [`LINEAR_MAX_K`], else O(len).
-    pub(crate) fn tighten_by_centres(&mut self, s2: &mut [f64]) {
-        if self.k == 0 || s2.len() < self.k {
+    /// 24.6, callgrind on `examples/knn_leaf`). Groups of more than
+    /// [`SEED_MAX`] change nothing. O(len · k) for `k <=` [`LINEAR_MAX_K`],
+    /// else O(len).
+    pub(crate) fn tighten_by_centres(&mut self, s2: &[f64]) {
+        if self.k == 0 || s2.len() < self.k || s2.len() > SEED_MAX {
             return;
         }
         // Non-negative and never NaN: their bits order them.
         let kth = if self.k <= LINEAR_MAX_K {
-            // The k smallest kept sorted: cheaper than the library's
-            // selection on a leaf's few dozen values (callgrind: ~750
-            // instructions a call there).
-            let mut top = [0u64; LINEAR_MAX_K];
+            // The k smallest kept sorted (`u64::MAX` for "none yet"):
+            // cheaper than the library's selection on a leaf's few dozen
+            // values (callgrind: ~750 instructions a call there). An entering
+            // value moves in by a min/max per slot, without a branch: where
+            // it stops is unpredictable, and the shifting loop it replaces
+            // mispredicted ~18 times a query (callgrind, W7 points k = 10).
+            let mut top = [u64::MAX; LINEAR_MAX_K];
             let k = self.k;
-            let mut len = 0;
             for &x in s2.iter() {
                 let x = x.to_bits();
-                if len == k {
-                    if x >= top[k - 1] {
-                        continue;
-                    }
-                } else {
-                    len += 1;
+                if x >= top[k - 1] {
+                    continue;
                 }
-                let mut i = len - 1;
-                while i > 0 && top[i - 1] > x {
-                    top[i] = top[i - 1];
-                    i -= 1;
+                // Slot j keeps the smaller of its value and the larger of
+                // its lower neighbour's and x: the insertion, from the top.
+                for j in (1..k).rev() {
+                    top[j] = top[j].min(top[j - 1].max(x));
                 }
-                top[i] = x;
+                top[0] = top[0].min(x);
             }
             f64::from_bits(top[k - 1])
         } else {
-            *s2.select_nth_unstable_by_key(self.k - 1, |x| x.to_bits()).1
+            // A copy, so that the caller's values keep their order.
+            let mut bits = [0u64; SEED_MAX];
+            for (b, x) in bits.iter_mut().zip(s2) {
+                *b = x.to_bits();
+            }
+            f64::from_bits(*bits[..s2.len()].select_nth_unstable(self.k - 1).1)
         };
         let d = overlap::distance_at_most_from_sq(kth);
         if d < self.limit {
@@ -810,13 +842,13 @@ mod tests {
             exact.sort_unstable_by(f32::total_cmp);
             let k = [1, 2, 5, 10, LINEAR_MAX_K, LINEAR_MAX_K + 1, 40][round % 7];
             let limit = if round % 11 == 0 { 0.0 } else { f32::INFINITY };
-            let mut s2: Vec<f64> = centres
+            let s2: Vec<f64> = centres
                 .iter()
                 .map(|&c| overlap::point_point_distance_sq(p, c))
                 .collect();
             let mut out = Vec::new();
             let mut best = KBest::new(&mut out, k, limit);
-            best.tighten_by_centres(&mut s2);
+            best.tighten_by_centres(&s2);
             let got = best.bound();
             match exact.get(k - 1) {
                 Some(&kth) if kth < limit => {

@@ -138,7 +138,10 @@ impl<T> LinearOctree<T> {
                 continue;
             }
             if n.leaf {
-                self.offer_leaf(n, q, filter, best);
+                // Many items pass at such k: one at a time is cheaper here
+                // than the depth-first search's two passes (W7 spheres,
+                // k = 100: 0.73-0.74x rstar against 0.77-0.78x).
+                self.offer_each(&n.items, q, filter, best);
                 continue;
             }
             let (dist, mut mask, _) = self.near_children(n, p.c, p.d, q, best);
@@ -164,18 +167,15 @@ impl<T> LinearOctree<T> {
     /// predecessors may have lowered. The first leaf reached (unfiltered
     /// queries) bounds the answer from the same squared distances before
     /// anything is offered (`KBest::tighten_by_centres`). Leaves over
-    /// `SEED_MAX` items (only at the depth cap) go one item at a time.
+    /// `SEED_MAX` items (only at the depth cap) go one item at a time, as do
+    /// the best-first search's.
     /// Always inlined: as a call from the depth-first recursion it cost 4%
     /// more instructions at k = 10 (callgrind, W7 points).
     #[inline(always)]
     fn offer_leaf(&self, n: &Node, q: &Nearest, filter: Option<Filter>, best: &mut KBest<'_>) {
         let items = &n.items;
         if items.len() > SEED_MAX {
-            for it in items {
-                let s2 = overlap::point_point_distance_sq(q.point, it.sphere.center);
-                self.offer_item(it, s2, q, filter, best);
-            }
-            return;
+            return self.offer_each(items, q, filter, best);
         }
         // Indices of the items not surely beyond the bound, without a branch
         // per item.
@@ -203,6 +203,21 @@ impl<T> LinearOctree<T> {
         // than keeping every item's (an array to initialise per leaf).
         for &i in &pass[..m] {
             let it = &items[i as usize];
+            let s2 = overlap::point_point_distance_sq(q.point, it.sphere.center);
+            self.offer_item(it, s2, q, filter, best);
+        }
+    }
+
+    /// Offers each of `items` that may enter `best`, one at a time.
+    #[inline(always)]
+    fn offer_each(
+        &self,
+        items: &[Item],
+        q: &Nearest,
+        filter: Option<Filter>,
+        best: &mut KBest<'_>,
+    ) {
+        for it in items {
             let s2 = overlap::point_point_distance_sq(q.point, it.sphere.center);
             self.offer_item(it, s2, q, filter, best);
         }

@@ -267,9 +267,15 @@ impl<T> LinearOctree<T> {
         d: u32,
         q: &Nearest,
     ) -> ([f64; 2], [f64; 2], [f64; 2]) {
-        let halves = self.child_halves(n, c, d);
-        let gap = |a: usize| halves[a].map(|(lo, hi)| overlap::axis_gap_sq(q.point[a], lo, hi));
-        (gap(0), gap(1), gap(2))
+        let [x, y, z] = self.child_halves(n, c, d);
+        let p = q.point;
+        let gap = |v: f32, [(l0, h0), (l1, h1)]: [(f32, f32); 2]| {
+            [
+                overlap::axis_gap_sq(v, l0, h0),
+                overlap::axis_gap_sq(v, l1, h1),
+            ]
+        };
+        (gap(p.x, x), gap(p.y, y), gap(p.z, z))
     }
 
     /// The squared distances to the boxes of inner node `n`'s children (at

@@ -517,3 +517,58 @@ fn clear_memory_and_stats() {
     assert!(t.memory_bytes() < m / 4);
     assert_eq!(t.stats().nodes, 1);
 }
+
+/// `child_halves` gives every child the same `f32` box as `loose_of` with
+/// its parent's extent, bit for bit, in a world whose cell sides and
+/// corners round (the k-nearest and ray searches prune with the halves, and
+/// `validate` checks the loose boxes).
+#[test]
+fn child_halves_are_the_childrens_loose_boxes_bit_for_bit() {
+    let mut rng = Pcg64::seed_from_u64(61);
+    let mut t = LinearOctree::with_config(OctreeConfig {
+        world: Aabb::new(vec3(-3.7, 1.3, 0.1), vec3(97.1, 50.9, 33.3)),
+        ..cfg(2, 1, 8)
+    })
+    .unwrap();
+    for i in 0..600 {
+        let c = vec3(
+            rng.gen_range(-3.0..97.0),
+            rng.gen_range(1.5..50.0),
+            rng.gen_range(0.2..33.0),
+        );
+        t.insert(Sphere::new(c, rng.gen_range(0.0..2.0)), i)
+            .unwrap();
+    }
+    let mut stack = vec![(t.root, [0u32; 3], 0u32)];
+    let mut checked = 0;
+    while let Some((i, c, d)) = stack.pop() {
+        let n = &t.nodes[i];
+        if n.leaf {
+            continue;
+        }
+        let halves = t.child_halves(n, c, d);
+        for (k, &ch) in n.children.iter().enumerate() {
+            if ch == node::NONE {
+                continue;
+            }
+            let cc = query::child_coords(c, k);
+            let want = t.loose_of(cc, d + 1, n.max_extent);
+            for a in 0..3 {
+                let (lo, hi) = halves[a][(k >> a) & 1];
+                assert_eq!(
+                    lo.to_bits(),
+                    want.min[a].to_bits(),
+                    "node {i} child {k} axis {a}"
+                );
+                assert_eq!(
+                    hi.to_bits(),
+                    want.max[a].to_bits(),
+                    "node {i} child {k} axis {a}"
+                );
+            }
+            stack.push((ch, cc, d + 1));
+            checked += 1;
+        }
+    }
+    assert!(checked > 50, "{checked}");
+}

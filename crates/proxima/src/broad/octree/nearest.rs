@@ -79,9 +79,9 @@ impl<T> LinearOctree<T> {
     /// from its items' centre distances before it offers any
     /// (`KBest::tighten_by_centres`; unfiltered queries), so later leaves
     /// are pruned against a near-final bound and few candidates are
-    /// inserted only to be evicted. Octants are searched nearest first (at
-    /// most 8 sorted on the stack per level, the rest skipped at the first
-    /// one beyond the bound), or from
+    /// inserted only to be evicted. Octants are searched nearest first (up
+    /// to rounding, `octants_nearest_first`; each tested against the bound
+    /// when its turn comes), or from
     /// `BEST_FIRST_MIN_K` answers on all pending nodes nearest first (a
     /// per-thread frontier heap). The filter is checked at each
     /// candidate that could enter. No allocation once `out` holds `k` entries.

@@ -55,7 +55,8 @@ impl Metric {
     /// `s2` ([`overlap::point_point_distance_sq`]), surely cannot enter
     /// `best` in this metric ([`KBest::exceeds`]): the pruning half of
     /// [`Metric::distance_within`], for searches that test a whole group of
-    /// candidates before computing any distance. O(1), no branch.
+    /// candidates before computing any distance. O(1); no branch but the
+    /// metric's (the same for a whole query).
     #[inline]
     pub(crate) fn excluded(self, s2: f64, s: &Sphere, best: &KBest<'_>) -> bool {
         match self {
@@ -313,7 +314,8 @@ impl<'a> KBest<'a> {
     /// (octree, 100k points, k = 10: 17.1 insertions a query instead of
     /// 24.6, callgrind on `examples/knn_leaf`). Groups of more than
     /// [`SEED_MAX`] change nothing. O(len · k) for `k <=` [`LINEAR_MAX_K`],
-    /// else O(len).
+    /// else O(len) (the octree seeds only its depth-first search, `k < 32`,
+    /// so that branch serves other callers and the tests).
     pub(crate) fn tighten_by_centres(&mut self, s2: &[f64]) {
         if self.k == 0 || s2.len() < self.k || s2.len() > SEED_MAX {
             return;

@@ -75,9 +75,10 @@ impl<T> LinearOctree<T> {
     /// the rounded distances are monotone, so a pruned subtree holds nothing
     /// that could have entered and the answer is brute force's, bit for bit.
     /// Candidates are tested the same way before their exact distance
-    /// (`Metric::distance_within`). The first leaf reached bounds the answer
-    /// from its items' centre distances before it offers any
-    /// (`KBest::tighten_by_centres`; unfiltered queries), so later leaves
+    /// (`Metric::excluded`, `Metric::distance_within_given_sq`). In the
+    /// depth-first search (`k <` `BEST_FIRST_MIN_K`) the first leaf reached
+    /// bounds the answer from its items' centre distances before it offers
+    /// any (`KBest::tighten_by_centres`; unfiltered queries), so later leaves
     /// are pruned against a near-final bound and few candidates are
     /// inserted only to be evicted. Octants are searched nearest first (up
     /// to rounding, `octants_nearest_first`; each tested against the bound

@@ -242,6 +242,8 @@ pub(crate) struct KBest<'a> {
     mid: f64,
     /// `exceeds_threshold(mid, 0)`: the squared threshold of boxes and points.
     mid_sq: f64,
+    /// `sq_threshold_f32(mid_sq)`: the `f32` pre-test's threshold.
+    mid_sq_f32: f32,
 }
 
 impl<'a> KBest<'a> {
@@ -256,6 +258,7 @@ impl<'a> KBest<'a> {
             bound: f32::NAN,
             mid: 0.0,
             mid_sq: 0.0,
+            mid_sq_f32: 0.0,
         };
         best.set_bound(limit);
         best
@@ -292,12 +295,23 @@ impl<'a> KBest<'a> {
         s2 > self.mid_sq
     }
 
+    /// Whether a point whose [`overlap::point_point_distance_sq_f32`] is
+    /// `s2f` surely cannot enter as a centre (`Metric::Center`, or a zero
+    /// radius): then [`KBest::exceeds_sq`] holds for its `f64` squared
+    /// distance too ([`overlap::sq_threshold_f32`]). A pre-test: `false`
+    /// still needs the `f64` test. O(1).
+    #[inline]
+    pub(crate) fn exceeds_sq_f32(&self, s2f: f32) -> bool {
+        s2f > self.mid_sq_f32
+    }
+
     fn set_bound(&mut self, bound: f32) {
         // Bit equality: a bound of -0.0 and 0.0 give the same midpoint anyway.
         if bound.to_bits() != self.bound.to_bits() {
             self.bound = bound;
             self.mid = overlap::distance_midpoint(bound);
             self.mid_sq = overlap::exceeds_threshold(self.mid, 0.0);
+            self.mid_sq_f32 = overlap::sq_threshold_f32(self.mid_sq);
         }
     }
 
@@ -320,31 +334,37 @@ impl<'a> KBest<'a> {
         if self.k == 0 || s2.len() < self.k || s2.len() > SEED_MAX {
             return;
         }
-        // Non-negative and never NaN: their bits order them.
         let kth = if self.k <= LINEAR_MAX_K {
-            // The k smallest kept sorted (`u64::MAX` for "none yet"):
-            // cheaper than the library's selection on a leaf's few dozen
-            // values (callgrind: ~750 instructions a call there). An entering
-            // value moves in by a min/max per slot, without a branch: where
-            // it stops is unpredictable, and the shifting loop it replaces
+            // The k smallest kept sorted (`∞` for "none yet"): cheaper than
+            // the library's selection on a leaf's few dozen values
+            // (callgrind: ~750 instructions a call there). An entering value
+            // moves in by a min/max per slot, without a branch: where it
+            // stops is unpredictable, and the shifting loop it replaces
             // mispredicted ~18 times a query (callgrind, W7 points k = 10).
-            let mut top = [u64::MAX; LINEAR_MAX_K];
+            // The values are never NaN, so the plain comparisons below are
+            // `min` and `max` and compile to one instruction each (`f64::min`
+            // handles NaN, and the `u64` bits have no SSE2 min: both cost
+            // several: 1.70k -> 1.01k instructions a query, callgrind on
+            // `examples/knn_leaf`, 100k points, k = 10).
+            let lo = |a: f64, b: f64| if a < b { a } else { b };
+            let hi = |a: f64, b: f64| if a > b { a } else { b };
+            let mut top = [f64::INFINITY; LINEAR_MAX_K];
             let k = self.k;
             for &x in s2.iter() {
-                let x = x.to_bits();
                 if x >= top[k - 1] {
                     continue;
                 }
                 // Slot j keeps the smaller of its value and the larger of
                 // its lower neighbour's and x: the insertion, from the top.
                 for j in (1..k).rev() {
-                    top[j] = top[j].min(top[j - 1].max(x));
+                    top[j] = lo(top[j], hi(top[j - 1], x));
                 }
-                top[0] = top[0].min(x);
+                top[0] = lo(top[0], x);
             }
-            f64::from_bits(top[k - 1])
+            top[k - 1]
         } else {
-            // A copy, so that the caller's values keep their order.
+            // Non-negative and never NaN: their bits order them. A copy, so
+            // that the caller's values keep their order.
             let mut bits = [0u64; SEED_MAX];
             for (b, x) in bits.iter_mut().zip(s2) {
                 *b = x.to_bits();
@@ -370,12 +390,6 @@ impl<'a> KBest<'a> {
         }
         let (h, k) = (&mut *self.held, self.k);
         if self.sorted {
-            if h.len() == k {
-                if !Neighbor::precedes(&n, &h[k - 1]) {
-                    return;
-                }
-                h.pop();
-            }
             if k <= LINEAR_MAX_K {
                 // Shift the entries `n` precedes up by one from the end: for
                 // small `k` about as many instructions as a binary search and
@@ -384,15 +398,32 @@ impl<'a> KBest<'a> {
                 // `knn_leaf`, 100k points, k = 10, one run each: 3.0 -> 2.2 µs
                 // a query together with the reused squared distance). The
                 // same position: the entries `n` precedes are exactly those
-                // after `insertion_point`.
-                let mut i = h.len();
-                h.push(n);
-                while i > 0 && Neighbor::precedes(&n, &h[i - 1]) {
-                    h[i] = h[i - 1];
+                // after `insertion_point`. A full set drops its last entry by
+                // writing over it; the shift runs on a plain slice, whose
+                // length stays in a register (through the `Vec` it was
+                // re-read each step: 135 -> 111 instructions an offer).
+                let s: &mut [Neighbor] = if h.len() == k {
+                    if !Neighbor::precedes(&n, &h[k - 1]) {
+                        return;
+                    }
+                    h
+                } else {
+                    h.push(n);
+                    h
+                };
+                let mut i = s.len() - 1;
+                while i > 0 && Neighbor::precedes(&n, &s[i - 1]) {
+                    s[i] = s[i - 1];
                     i -= 1;
                 }
-                h[i] = n;
+                s[i] = n;
             } else {
+                if h.len() == k {
+                    if !Neighbor::precedes(&n, &h[k - 1]) {
+                        return;
+                    }
+                    h.pop();
+                }
                 let i = insertion_point(h, &n);
                 h.insert(i, n);
             }

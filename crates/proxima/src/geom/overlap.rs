@@ -830,6 +830,36 @@ pub fn point_point_distance_sq(p: Vec3, c: Vec3) -> f64 {
     dot(diff, diff)
 }
 
+/// `|c - p|²` evaluated in `f32` (three differences, three products, two
+/// sums, each rounded): a cheap pre-test beside [`point_point_distance_sq`],
+/// with no conversions to `f64`. It is at most `(1 + u)^5` times the exact
+/// value plus `3·2^-150` for the products that underflow (`u = 2^-24`), or `∞`
+/// only when the exact value is above `f32::MAX·(1 - 4u)`; so whenever
+/// [`point_point_distance_sq`] is at most `t`, this is at most
+/// [`sq_threshold_f32`]`(t)`. O(1).
+#[inline]
+pub(crate) fn point_point_distance_sq_f32(p: Vec3, c: Vec3) -> f32 {
+    let (x, y, z) = (c.x - p.x, c.y - p.y, c.z - p.z);
+    x * x + y * y + z * z
+}
+
+/// The `f32` threshold for [`point_point_distance_sq_f32`] that keeps every
+/// point whose [`point_point_distance_sq`] is at most `t` (a non-negative
+/// `f64`): `t` grown by `2^-18` relative (the `f32` sum's `5u` and the `f64`
+/// one's `3·2^-53` with room to spare) and by `f32::MIN_POSITIVE` (the
+/// underflow), rounded up to `f32` (`∞` past `f32::MAX`). A pre-test with it
+/// only ever keeps too many, never drops one. O(1).
+#[inline]
+pub(crate) fn sq_threshold_f32(t: f64) -> f32 {
+    let x = t * (1.0 + 1.0 / 262_144.0) + f32::MIN_POSITIVE as f64;
+    let f = x as f32;
+    if (f as f64) < x {
+        f32::from_bits(f.to_bits() + 1)
+    } else {
+        f
+    }
+}
+
 /// An `f32` at least the correctly rounded distance `|c - p|`, given
 /// `s2 = `[`point_point_distance_sq`]`(p, c)`: `s2` is within `3u` relative
 /// of `|c - p|²` and the root adds half an ulp, so `sqrt(s2)·(1 + 1e-12)` is
@@ -1417,6 +1447,55 @@ mod tests {
             let y = f32::from_bits((st >> 33) as u32 % f32::INFINITY.to_bits());
             check(y);
         }
+    }
+
+    /// The `f32` pre-test keeps every point the `f64` test keeps, at the
+    /// hardest threshold (the point's own `f64` squared distance), at every
+    /// magnitude from subnormal differences to sums that overflow `f32`;
+    /// and its threshold is tight (not `∞` unless it must be).
+    #[test]
+    fn f32_squared_distance_stays_within_its_threshold() {
+        let mut st = 0xD1B5_4A32_D192_ED03u64;
+        let mut next = || {
+            st ^= st << 13;
+            st ^= st >> 7;
+            st ^= st << 17;
+            st
+        };
+        let tiny = f32::from_bits(1);
+        let mut kept_finite = 0;
+        for k in 0..200_000 {
+            let r = next();
+            let unit = |b: u64| (b >> 40) as f32 / (1u64 << 24) as f32 - 0.5;
+            let scale = [1e-44f32, 1e-38, 1e-20, 1.0, 1e19, 1e37, f32::MAX][k % 7];
+            let p = Vec3::new(unit(r), unit(r << 8), unit(r << 16)) * scale;
+            let r2 = next();
+            let c = match k % 5 {
+                // A neighbour a few ulps away on each axis.
+                0 => Vec3::new(
+                    f32::from_bits(p.x.to_bits() ^ (r2 as u32 & 7)),
+                    f32::from_bits(p.y.to_bits() ^ ((r2 >> 8) as u32 & 7)),
+                    f32::from_bits(p.z.to_bits() ^ ((r2 >> 16) as u32 & 7)),
+                ),
+                1 => p + Vec3::splat(tiny),
+                _ => Vec3::new(unit(r2), unit(r2 << 8), unit(r2 << 16)) * scale,
+            };
+            if !(p.is_finite() && c.is_finite()) {
+                continue;
+            }
+            let t = point_point_distance_sq(p, c);
+            let f = point_point_distance_sq_f32(p, c);
+            let th = sq_threshold_f32(t);
+            assert!(f <= th, "{p:?} {c:?}: {f:e} > {th:e} (t {t:e})");
+            let tight = t * (1.0 + 2f64.powi(-17)) + 2f64.powi(-125);
+            if tight < f32::MAX as f64 {
+                assert!((th as f64) <= tight, "{t:e}: threshold {th:e} is loose");
+                kept_finite += 1;
+            }
+        }
+        assert!(kept_finite > 100_000, "{kept_finite}");
+        assert_eq!(sq_threshold_f32(f64::INFINITY), f32::INFINITY);
+        assert_eq!(sq_threshold_f32(1e300), f32::INFINITY);
     }
 
     #[test]

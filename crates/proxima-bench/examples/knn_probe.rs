@@ -39,8 +39,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     hint.r_max = 0.5 * (1.0 / n as f32).cbrt();
     hint.r_largest = hint.r_largest.max(hint.r_max);
     let mut index = kind.build::<u32>(&hint)?;
-    for (i, &c) in points.iter().enumerate() {
-        index.insert(Sphere::new(c, 0.0), i as u32)?;
+    let insert_order: Vec<u32> = if a.get(6).is_some_and(|s| s == "morton") {
+        morton_order(&points)
+    } else {
+        (0..n as u32).collect()
+    };
+    for i in insert_order {
+        index.insert(Sphere::new(points[i as usize], 0.0), i)?;
     }
     let sorted: Vec<Vec3> = morton_order(&queries)
         .into_iter()

@@ -341,6 +341,17 @@ impl<T> LinearOctree<T> {
             order[m] = o;
             m += (mask >> o) as usize & 1;
         }
+        // Touch every child to be visited (and a leaf's first item) now, so
+        // that their cache misses overlap instead of following one another:
+        // `perf` put ~10% of the search's samples on the first read of a
+        // node and ~15% on a leaf's first item, each waiting for the one
+        // before. W7 points k = 10: 2.40-2.54 -> 2.29-2.35 µs a query (three
+        // alternations each). A plain read, since `unsafe` (a prefetch) is
+        // forbidden; the children are those in `mask`, never `NONE`.
+        for &o in &order[..m] {
+            let c = &self.nodes[n.children[o as usize]];
+            std::hint::black_box(c.items.first().map_or(0.0, |it| it.sphere.center.x));
+        }
         for &o in &order[..m] {
             let o = o as usize;
             // The bound may have fallen since the mask was made. The order is

@@ -2,9 +2,10 @@
 //! cube, metric "center", the radius hint the Python binding gives point
 //! clouds), queries one by one in random order and in Morton order
 //! ([`proxima::broad::morton_order`], what `Index.nearest` does with a
-//! batch). Wall-clock medians, and a small program to run under callgrind.
+//! batch). Points are inserted in their order, or in Morton order with a
+//! 7th argument `morton`. Wall-clock medians, and a small program to run under callgrind.
 //!
-//! `cargo run --release -p proxima-bench --example knn_probe -- KIND N K [REPS [QUERIES [random|sorted]]]`
+//! `cargo run --release -p proxima-bench --example knn_probe -- KIND N K [REPS [QUERIES [random|sorted|both [morton]]]]`
 use proxima::broad::SpatialIndex;
 use proxima::broad::{morton_order, IndexKind, Metric, Nearest, Neighbor, SceneHint};
 use proxima::geom::Sphere;
@@ -24,14 +25,20 @@ fn rng(mut s: u64) -> impl FnMut() -> f32 {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().skip(1).collect();
     if a.len() < 3 {
-        return Err("usage: knn_probe KIND N K [REPS [QUERIES [random|sorted]]]".into());
+        return Err(
+            "usage: knn_probe KIND N K [REPS [QUERIES [random|sorted|both [morton]]]]".into(),
+        );
     }
     let kind: IndexKind = a[0].parse()?;
     let n: usize = a[1].parse()?;
     let k: usize = a[2].parse()?;
     let reps: usize = a.get(3).map_or(Ok(3), |s| s.parse())?;
     let m: usize = a.get(4).map_or(Ok(n), |s| s.parse())?;
-    let only = a.get(5).cloned().unwrap_or_default();
+    let only = a
+        .get(5)
+        .cloned()
+        .filter(|s| s != "both")
+        .unwrap_or_default();
     let mut r = rng(7);
     let points: Vec<Vec3> = (0..n).map(|_| Vec3::new(r(), r(), r())).collect();
     let queries: Vec<Vec3> = (0..m).map(|_| Vec3::new(r(), r(), r())).collect();

@@ -18,6 +18,10 @@ pub struct Ids {
     /// ties by handle, so while this holds their order is the ids' order;
     /// once a removed slot is reused it may not be.
     ordered: bool,
+    /// Whether every id issued so far got a handle whose slot is the id
+    /// itself (a fresh index filled in order, nothing removed before): then
+    /// a handle's id is its slot, with no lookup ([`Ids::id_of_slot`]).
+    slot_is_id: bool,
 }
 
 impl Ids {
@@ -28,6 +32,7 @@ impl Ids {
             holder,
             last: None,
             ordered: true,
+            slot_is_id: true,
         }
     }
 
@@ -52,6 +57,7 @@ impl Ids {
     /// Issues the next id, for `h`.
     pub fn push(&mut self, h: Handle) -> i64 {
         self.ordered &= self.last.is_none_or(|last| last < h);
+        self.slot_is_id &= h.index() as usize == self.handles.len();
         self.last = Some(h);
         self.handles.push(Some(h));
         (self.handles.len() - 1) as i64
@@ -91,6 +97,15 @@ impl Ids {
     /// "ties by smaller id". O(1).
     pub fn ordered(&self) -> bool {
         self.ordered
+    }
+
+    /// Whether a live handle's id is its slot ([`proxima::Handle::index`]):
+    /// true while every id issued got the slot of its own number (checked as
+    /// each is issued, so a reused slot turns it off for good). Batch answers
+    /// then name their objects without reading them back from the index, a
+    /// random memory access per neighbour. O(1).
+    pub fn id_of_slot(&self) -> bool {
+        self.slot_is_id
     }
 
     /// The live ids, ascending.

@@ -600,9 +600,13 @@ impl Index {
         let filter = query_filter(filter)?;
         let workers = Workers::new(workers)?;
         let pts: Vec<_> = v.chunks_exact(3).map(vec3).collect();
-        let (inner, ordered) = (&self.inner, self.ids.ordered());
+        let (inner, ordered, by_slot) = (&self.inner, self.ids.ordered(), self.ids.id_of_slot());
         let table = py
-            .detach(|| queries::nearest(inner, &pts, k, bound, metric, filter, ordered, &workers))
+            .detach(|| {
+                queries::nearest(
+                    inner, &pts, k, bound, metric, filter, ordered, by_slot, &workers,
+                )
+            })
             .or_raise()?;
         let d = PyArray1::from_vec(py, table.distances);
         let ids = PyArray1::from_vec(py, table.ids);

@@ -197,7 +197,9 @@ pub struct KnnTable {
 /// The library breaks ties by handle: id order while `ordered`; otherwise
 /// each answer's last distance `D` is re-queried for every object at most `D`
 /// away, and those are ordered by (distance, id) (about twice the cost).
-/// Points must be finite and `max_distance` not NaN or negative.
+/// With `by_slot` a handle's id is its slot (`Ids::id_of_slot`), read
+/// without a lookup. Points must be finite and `max_distance` not NaN or
+/// negative.
 #[allow(clippy::too_many_arguments)]
 pub fn nearest(
     index: &AnyIndex<u64>,
@@ -207,6 +209,7 @@ pub fn nearest(
     metric: Metric,
     filter: Option<Filter>,
     ordered: bool,
+    by_slot: bool,
     workers: &Workers,
 ) -> proxima::Result<KnnTable> {
     let m = points.len();
@@ -236,7 +239,13 @@ pub fn nearest(
                 scratch: &mut Vec<Neighbor>,
                 d: &mut [f32],
                 ids: &mut [i64]| {
-        let id = |h: Handle| index.get(h).map_or(-1, |(_, &id)| id as i64);
+        let id = |h: Handle| {
+            if by_slot {
+                h.index() as i64
+            } else {
+                index.get(h).map_or(-1, |(_, &id)| id as i64)
+            }
+        };
         if !ordered {
             let found: &[Neighbor] = if found.len() == k {
                 // Every object as near as the k-th, so that ties at the

@@ -19,7 +19,8 @@ pub struct Ids {
     /// once a removed slot is reused it may not be.
     ordered: bool,
     /// Whether every id issued so far got a handle whose slot is the id
-    /// itself (a fresh index filled in order, nothing removed before): then
+    /// itself (a fresh index filled in order; removals alone keep it, an
+    /// insert into a reused slot or any insert after a clear ends it): then
     /// a handle's id is its slot, with no lookup ([`Ids::id_of_slot`]).
     slot_is_id: bool,
 }

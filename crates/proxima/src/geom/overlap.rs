@@ -833,7 +833,7 @@ pub fn point_point_distance_sq(p: Vec3, c: Vec3) -> f64 {
 /// `|c - p|²` evaluated in `f32` (three differences, three products, two
 /// sums, each rounded): a cheap pre-test beside [`point_point_distance_sq`],
 /// with no conversions to `f64`. It is at most `(1 + u)^5` times the exact
-/// value plus `3·2^-150` for the products that underflow (`u = 2^-24`), or `∞`
+/// value plus about `3·2^-150` for the products that underflow (`u = 2^-24`), or `∞`
 /// only when the exact value is above `f32::MAX·(1 - 4u)`; so whenever
 /// [`point_point_distance_sq`] is at most `t`, this is at most
 /// [`sq_threshold_f32`]`(t)`. O(1).
@@ -846,7 +846,8 @@ pub(crate) fn point_point_distance_sq_f32(p: Vec3, c: Vec3) -> f32 {
 /// The `f32` threshold for [`point_point_distance_sq_f32`] that keeps every
 /// point whose [`point_point_distance_sq`] is at most `t` (a non-negative
 /// `f64`): `t` grown by `2^-18` relative (the `f32` sum's `5u` and the `f64`
-/// one's `3·2^-53` with room to spare) and by `f32::MIN_POSITIVE` (the
+/// one's error, under `6·2^-53` even where its differences round, with room
+/// to spare) and by `f32::MIN_POSITIVE` (the
 /// underflow), rounded up to `f32` (`∞` past `f32::MAX`). A pre-test with it
 /// only ever keeps too many, never drops one. O(1).
 #[inline]

@@ -57,11 +57,17 @@ rm -rf "$PY_OUT/wheels"
     "$PY_OUT"/wheels/proxima-*.whl
 
 # The CLI whose answers the collide tests compare with, built from these
-# sources (a no-op after `cargo test`; a stale binary would give stale answers).
+# sources (a stale binary would give stale answers). After `cargo test
+# --workspace` it is already there: the CLI's integration tests had cargo
+# build it, in the test profile, into target/debug. A `cargo build` would
+# build it again in the dev profile (88 s on 2 cores), so only the Python
+# part alone builds it.
 if [ -z "${PROXIMA_CLI:-}" ]; then
     PROXIMA_CLI=$ROOT/target/debug/proxima
-    say "building the CLI"
-    cargo build --quiet -p proxima-cli
+    if [ "$WHAT" = python ]; then
+        say "building the CLI"
+        cargo build --quiet -p proxima-cli
+    fi
 fi
 export PROXIMA_CLI
 

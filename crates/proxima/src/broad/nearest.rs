@@ -79,13 +79,21 @@ impl Metric {
         if self.excluded(s2, s, best) {
             return None;
         }
-        let distance = match self {
+        let distance = self.distance_given_sq(point, s, s2);
+        (distance <= best.bound()).then_some(distance)
+    }
+
+    /// [`Metric::distance`] when the caller already holds `s2 =`
+    /// [`overlap::point_point_distance_sq`]`(point, s.center)`: the same
+    /// value, bit for bit. O(1).
+    #[inline]
+    pub(crate) fn distance_given_sq(self, point: Vec3, s: &Sphere, s2: f64) -> f32 {
+        match self {
             Metric::Surface => overlap::point_sphere_distance_given_sq(point, s, s2),
             Metric::Center => {
                 overlap::point_sphere_distance_given_sq(point, &Sphere::new(s.center, 0.0), s2)
             }
-        };
-        (distance <= best.bound()).then_some(distance)
+        }
     }
 }
 
@@ -244,6 +252,10 @@ pub(crate) struct KBest<'a> {
     mid_sq: f64,
     /// `sq_threshold_f32(mid_sq)`: the `f32` pre-test's threshold.
     mid_sq_f32: f32,
+    /// The bound `mid`, `mid_sq` and `mid_sq_f32` were computed from: equal to
+    /// `bound` but after [`KBest::offer_unsynced`], whose caller syncs them
+    /// later ([`KBest::sync`]).
+    synced: f32,
 }
 
 impl<'a> KBest<'a> {
@@ -259,6 +271,7 @@ impl<'a> KBest<'a> {
             mid: 0.0,
             mid_sq: 0.0,
             mid_sq_f32: 0.0,
+            synced: f32::NAN,
         };
         best.set_bound(limit);
         best
@@ -306,10 +319,19 @@ impl<'a> KBest<'a> {
     }
 
     fn set_bound(&mut self, bound: f32) {
+        self.bound = bound;
+        self.sync();
+    }
+
+    /// Brings the pruning thresholds of [`KBest::exceeds`],
+    /// [`KBest::exceeds_sq`] and [`KBest::exceeds_sq_f32`] to the current
+    /// bound, after offers made with [`KBest::offer_unsynced`]. O(1).
+    #[inline]
+    pub(crate) fn sync(&mut self) {
         // Bit equality: a bound of -0.0 and 0.0 give the same midpoint anyway.
-        if bound.to_bits() != self.bound.to_bits() {
-            self.bound = bound;
-            self.mid = overlap::distance_midpoint(bound);
+        if self.bound.to_bits() != self.synced.to_bits() {
+            self.synced = self.bound;
+            self.mid = overlap::distance_midpoint(self.bound);
             self.mid_sq = overlap::exceeds_threshold(self.mid, 0.0);
             self.mid_sq_f32 = overlap::sq_threshold_f32(self.mid_sq);
         }
@@ -385,6 +407,18 @@ impl<'a> KBest<'a> {
     /// when sorted.
     #[inline]
     pub(crate) fn offer(&mut self, n: Neighbor) {
+        self.offer_unsynced(n);
+        self.sync();
+    }
+
+    /// [`KBest::offer`] that updates [`KBest::bound`] but leaves the pruning
+    /// thresholds at an earlier bound until [`KBest::sync`]: for a group of
+    /// offers in a row, which need only the bound. Until then the
+    /// `exceeds*` tests are still sound, only looser (the bound never
+    /// rises, and the thresholds grow with it), so a search that tests with
+    /// them before syncing prunes less but never wrongly.
+    #[inline]
+    pub(crate) fn offer_unsynced(&mut self, n: Neighbor) {
         if n.distance > self.limit || self.k == 0 {
             return;
         }
@@ -429,7 +463,7 @@ impl<'a> KBest<'a> {
             }
             if h.len() == k {
                 let worst = h[k - 1].distance;
-                self.set_bound(worst);
+                self.bound = worst;
             }
             return;
         }
@@ -468,7 +502,7 @@ impl<'a> KBest<'a> {
         }
         if h.len() == k {
             let worst = h[0].distance;
-            self.set_bound(worst);
+            self.bound = worst;
         }
     }
 
@@ -707,9 +741,10 @@ mod tests {
     /// `KBest` in both representations (sorted up to `SORTED_MAX_K`, heap
     /// beyond) against a full sort, on long random sequences dense in exact
     /// ties, duplicates (same handle and distance) and one-ulp near-ties,
-    /// for `k` on both sides of the switch, with and without a limit; after
-    /// every offer its cached bound and pruning tests agree with
-    /// `overlap::distance_exceeds` on the bound it reports.
+    /// for `k` on both sides of the switch, with and without a limit, offered
+    /// synced or not (`offer_unsynced`); its bound is the k-th's after every
+    /// offer, its pruning tests never prune what `overlap::distance_exceeds`
+    /// on that bound keeps, and after `sync` they agree with it.
     #[test]
     fn kbest_matches_a_full_sort_on_both_sides_of_the_switch() {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(14);
@@ -750,12 +785,24 @@ mod tests {
                         rng.gen_range(0.0f32..3.0)
                     };
                     let n = neighbor(rng.gen_range(0..64), d);
-                    best.offer(n);
+                    if rng.gen_bool(0.5) {
+                        best.offer(n);
+                    } else {
+                        best.offer_unsynced(n);
+                    }
                     if d <= limit {
                         all.push(n);
                     }
                     if step % 97 == 0 || step + 1 == 3 * s {
                         let b = best.bound();
+                        // Not yet synced: the tests prune only what the
+                        // bound prunes.
+                        for s2 in [0.0, 1.0, 1.0 + 1e-9, 4.0, 4.0 * (1.0 + 1e-7), 9.0] {
+                            let r = 0.25;
+                            assert!(!best.exceeds_sq(s2) || overlap::distance_exceeds(s2, 0.0, b));
+                            assert!(!best.exceeds(s2, r) || overlap::distance_exceeds(s2, r, b));
+                        }
+                        best.sync();
                         let mut want = all.clone();
                         want.sort_unstable_by(Neighbor::order);
                         // k = 0 holds nothing: the bound stays the limit.

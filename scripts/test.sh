@@ -11,8 +11,9 @@
 # (once: later runs find them installed and ask the index nothing), builds the
 # proxima wheel (abi3) with maturin into target/py/wheels, installs it, and runs
 # pytest on crates/proxima-py/tests. Idempotent; a second run rebuilds only
-# what changed. The collide tests compare with the CLI, so the Python part
-# builds `proxima` (the CLI) too if it is not there (PROXIMA_CLI names another).
+# what changed. The collide tests compare with the CLI (PROXIMA_CLI names
+# another): in the whole run `cargo test --workspace` has built it, and
+# `scripts/test.sh python` builds it.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)

@@ -235,7 +235,8 @@ pub(crate) const SEED_MAX: usize = 64;
 /// `k <=` [`SORTED_MAX_K`] the buffer is kept in answer order
 /// ([`Neighbor::order`]), beyond it as a max-heap (worst first). It also keeps
 /// the pruning threshold of its bound ([`overlap::distance_midpoint`]), which
-/// changes only when a candidate enters, so the per-candidate and per-node
+/// changes only when a candidate enters (or, after
+/// [`KBest::offer_unsynced`], at [`KBest::sync`]), so the per-candidate and per-node
 /// tests ([`KBest::exceeds`], [`KBest::exceeds_sq`]) are one or two flops and
 /// a comparison. No allocation once the buffer holds `k` entries.
 pub(crate) struct KBest<'a> {
@@ -350,8 +351,9 @@ impl<'a> KBest<'a> {
     /// (octree, 100k points, k = 10: 17.1 insertions a query instead of
     /// 24.6, callgrind on `examples/knn_leaf`). Groups of more than
     /// [`SEED_MAX`] change nothing. O(len · k) for `k <=` [`LINEAR_MAX_K`],
-    /// else O(len) (the octree seeds only its depth-first search, `k < 32`,
-    /// so that branch serves other callers and the tests).
+    /// else O(len) (the octree's only: a leaf of at least `k` items, which
+    /// for `k > 32` takes a `max_per_leaf` above the default or the depth
+    /// cap).
     pub(crate) fn tighten_by_centres(&mut self, s2: &[f64]) {
         if self.k == 0 || s2.len() < self.k || s2.len() > SEED_MAX {
             return;
@@ -801,6 +803,13 @@ mod tests {
                             let r = 0.25;
                             assert!(!best.exceeds_sq(s2) || overlap::distance_exceeds(s2, 0.0, b));
                             assert!(!best.exceeds(s2, r) || overlap::distance_exceeds(s2, r, b));
+                            assert!(
+                                !best.exceeds_sq_f32(s2 as f32)
+                                    || overlap::sq_threshold_f32(overlap::exceeds_threshold(
+                                        overlap::distance_midpoint(b),
+                                        0.0
+                                    )) < s2 as f32
+                            );
                         }
                         best.sync();
                         let mut want = all.clone();

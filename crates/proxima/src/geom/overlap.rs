@@ -819,9 +819,11 @@ pub fn point_aabb_distance(p: Vec3, b: &Aabb) -> f32 {
     point_sphere_distance(p, &Sphere::new(p.clamp(b.min, b.max), 0.0))
 }
 
-/// `|c - p|²` evaluated in `f64` (the differences are exact, the squares and
-/// sums round three times: within `3u` relative of the exact value, never
-/// overflowing or underflowing for finite `f32` inputs). The cheap half of
+/// `|c - p|²` evaluated in `f64`: each difference is exact unless the two
+/// coordinates' exponents are more than 29 apart, and then rounds once
+/// (within `u` of itself), and the squares and sums round three times: within
+/// `6u` relative of the exact value (`u = 2^-53`), never overflowing or
+/// underflowing for finite `f32` inputs. The cheap half of
 /// [`distance_exceeds`]. O(1), no square root.
 #[inline]
 pub fn point_point_distance_sq(p: Vec3, c: Vec3) -> f64 {
@@ -862,7 +864,7 @@ pub(crate) fn sq_threshold_f32(t: f64) -> f32 {
 }
 
 /// An `f32` at least the correctly rounded distance `|c - p|`, given
-/// `s2 = `[`point_point_distance_sq`]`(p, c)`: `s2` is within `3u` relative
+/// `s2 = `[`point_point_distance_sq`]`(p, c)`: `s2` is within `6u` relative
 /// of `|c - p|²` and the root adds half an ulp, so `sqrt(s2)·(1 + 1e-12)` is
 /// above the exact distance, and rounding it up keeps it above the correctly
 /// rounded one (rounding is monotone). `∞` beyond `f32::MAX`. The k-nearest
@@ -904,7 +906,7 @@ pub fn axis_gap_sq(p: f32, lo: f32, hi: f32) -> f64 {
 /// midpoint `m` between `d` and the next `f32` up (at `m` exactly, ties to
 /// even may round down, so only `> m` counts), i.e. iff `|c - p| > m + r`,
 /// i.e. `|c - p|² > (m + r)²` (both sides non-negative as `m > 0`). `s2` is
-/// within `3u` of `|c - p|²` and `(m + r)²` is evaluated within `3u`; a margin
+/// within `6u` of `|c - p|²` and `(m + r)²` is evaluated within `3u`; a margin
 /// of 1e-12 relative covers both. O(1): a few flops, no square root.
 #[inline]
 pub fn distance_exceeds(s2: f64, r: f32, d: f32) -> bool {

@@ -75,9 +75,9 @@ impl<T> LinearOctree<T> {
     /// the rounded distances are monotone, so a pruned subtree holds nothing
     /// that could have entered and the answer is brute force's, bit for bit.
     /// Candidates are tested the same way before their exact distance
-    /// (`Metric::excluded`, then the exact distance). The first leaf
-    /// reached, if it holds at least `k` items (in practice: the depth-first
-    /// search, `k <` `BEST_FIRST_MIN_K`), bounds the answer from its items'
+    /// (`Metric::excluded`, then the exact distance). A leaf reached while
+    /// nothing is held (the first, in practice), if it holds `k` to
+    /// `SEED_MAX` items, bounds the answer from its items'
     /// centre distances before it offers any (`KBest::tighten_by_centres`;
     /// unfiltered queries), so later leaves
     /// are pruned against a near-final bound and few candidates are
@@ -143,7 +143,7 @@ impl<T> LinearOctree<T> {
                 // The depth-first search's leaf step. One item at a time was
                 // cheaper here while each distance waited on the offer
                 // before it; with the passers' distances computed first, the
-                // two passes are faster (W7 spheres k = 100: 16.7 against
+                // three loops are faster (W7 spheres k = 100: 16.7 against
                 // 17.9 µs a query, medians of seven alternations; points
                 // k = 100: 14.2-16.6 against 16.5-19.7).
                 self.offer_leaf(n, q, filter, best);
@@ -163,17 +163,18 @@ impl<T> LinearOctree<T> {
         }
     }
 
-    /// Offers every item of leaf `n` that may enter `best`, in two passes:
+    /// Offers every item of leaf `n` that may enter `best`, in three loops:
     /// the squared centre distances of all items and the list of those not
     /// surely beyond the bound (no branch per item: which items pass is
     /// unpredictable, and a mispredicted branch per passer cost ~16 a
     /// query, callgrind W7 points k = 10), then the exact distances of
     /// those, and then their offers, each tested again against the bound
     /// its predecessors may have lowered (`KBest::offer_unsynced`; W7 points
-    /// k = 10: ~3% faster on the probe `knn_leaf` than a distance and an
-    /// offer in turn, eight alternations). The first leaf reached (unfiltered
-    /// queries) bounds the answer from the same squared distances before
-    /// anything is offered (`KBest::tighten_by_centres`). Leaves over
+    /// k = 10: median 2.27 -> 2.18 µs a query on the probe `knn_leaf`
+    /// against a distance and an offer in turn, 22 alternations). A leaf
+    /// reached while nothing is held (unfiltered queries) bounds the answer
+    /// from the same squared distances before anything is offered
+    /// (`KBest::tighten_by_centres`). Leaves over
     /// `SEED_MAX` items (only at the depth cap) go one item at a time. Both
     /// searches take this step.
     /// Always inlined: as a call from the depth-first recursion it cost 4%
@@ -216,7 +217,8 @@ impl<T> LinearOctree<T> {
             }
         }
         // The few that pass compute their squared distance again (cheaper
-        // than keeping every item's: an array to initialise per leaf), and
+        // than keeping every item's in `f64`, measured before the `f32`
+        // pre-test: a `memset` call per leaf and more mispredicts), and
         // their distances all before any is offered: no distance then waits
         // for the offer before it (each offer lowers the bound the next
         // test reads, and mispredicts where it inserts), so their square

@@ -6,7 +6,7 @@
 use super::node::{Item, Node, NONE};
 use super::query::child_coords;
 use super::LinearOctree;
-use crate::broad::nearest::{KBest, Metric, Nearest, Neighbor, SEED_MAX};
+use crate::broad::nearest::{KBest, Metric, Nearest, Neighbor, LINEAR_MAX_K, SEED_MAX};
 use crate::broad::Filter;
 use crate::geom::overlap;
 use std::cell::RefCell;
@@ -174,7 +174,8 @@ impl<T> LinearOctree<T> {
     /// against a distance and an offer in turn, 22 alternations). A leaf
     /// reached while nothing is held (unfiltered queries) bounds the answer
     /// from the same squared distances before anything is offered
-    /// (`KBest::tighten_by_centres`). Leaves over
+    /// (`KBest::tighten_by_centres`), and offers the `k` it bounds by first,
+    /// nearest first. Leaves over
     /// `SEED_MAX` items (only at the depth cap) go one item at a time. Both
     /// searches take this step.
     /// Always inlined: as a call from the depth-first recursion it cost 4%
@@ -188,7 +189,9 @@ impl<T> LinearOctree<T> {
         let metric = leaf_metric(n, q);
         // Indices of the items not surely beyond the bound, without a branch
         // per item.
-        let mut pass = [0u8; SEED_MAX];
+        // One more than a leaf's items: with the first `k` listed ahead, the
+        // branch-free loop below may write one slot past the last passer.
+        let mut pass = [0u8; SEED_MAX + 1];
         let mut m = 0;
         if best.is_empty() && filter.is_none() {
             let mut s2 = [0.0f64; SEED_MAX];
@@ -196,10 +199,23 @@ impl<T> LinearOctree<T> {
             for (d, it) in s2.iter_mut().zip(items) {
                 *d = overlap::point_point_distance_sq(q.point, it.sphere.center);
             }
-            best.tighten_by_centres(s2);
+            // The k it bounds by go first, nearest first, so that each
+            // enters at the end of the set, then the others that pass.
+            // Against the leaf's order: 89 -> 77 mispredicts a query,
+            // 12.4k -> 12.6k instructions (callgrind); probe median 2.12
+            // -> 2.03 µs a query, faster in 17 of 20 alternations (W7
+            // points k = 10, `knn_leaf 100000 10 50000 32`).
+            let mut first = [0u8; LINEAR_MAX_K];
+            let taken = best.tighten_by_centres(s2, &mut first);
+            pass[..taken].copy_from_slice(&first[..taken]);
+            m = taken;
+            let mut is_first = 0u64;
+            for &i in &first[..taken] {
+                is_first |= 1 << i;
+            }
             for (i, (&d, it)) in s2.iter().zip(items).enumerate() {
                 pass[m] = i as u8;
-                m += !metric.excluded(d, &it.sphere, best) as usize;
+                m += (!metric.excluded(d, &it.sphere, best) & (is_first >> i & 1 == 0)) as usize;
             }
         } else if metric == Metric::Center {
             // In `f32`: no conversions, and the passers' exact test below

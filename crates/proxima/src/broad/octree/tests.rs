@@ -572,3 +572,62 @@ fn child_halves_are_the_childrens_loose_boxes_bit_for_bit() {
     }
     assert!(checked > 50, "{checked}");
 }
+
+/// A leaf of `SEED_MAX` (64) items, past `max_per_leaf` at the depth cap,
+/// most of them duplicates at one point: the first leaf's seed lists the `k`
+/// it bounds by ahead of the other passers, and with every item passing the
+/// branch-free list writes one slot past the leaf's 64 (found while writing
+/// the seed order: a 64-slot list would panic at k = 1). Brute force's ids
+/// and distances, for k = 1, 2, 10, 64 and 70, from points on, beside and
+/// away from the duplicates, both metrics.
+#[test]
+fn nearest_over_a_full_leaf_of_duplicates_at_the_depth_cap() {
+    use crate::broad::{BruteForce, Metric, Nearest};
+    let p = vec3(10.25, 20.5, 30.75);
+    for (dups, radius) in [(64usize, 0.0f32), (64, 0.5), (63, 0.0), (40, 0.0)] {
+        let mut t = LinearOctree::with_config(cfg(8, 4, 3)).unwrap();
+        let mut brute = BruteForce::new();
+        let mut ids = (Vec::new(), Vec::new());
+        for i in 0..64 {
+            // The rest of the leaf just beside the duplicates, same cell.
+            let c = if i < dups {
+                p
+            } else {
+                p + Vec3::splat(0.001 * i as f32)
+            };
+            let s = Sphere::new(c, radius);
+            ids.0.push(t.insert(s, i).unwrap());
+            ids.1.push(brute.insert(s, i).unwrap());
+        }
+        t.validate().unwrap();
+        let mut largest = 0;
+        t.for_each_leaf(|_, n| largest = largest.max(n));
+        assert_eq!(largest, 64, "one leaf holds all 64");
+        for q in [p, p + vec3(0.5, 0.0, 0.0), vec3(60.0, 1.0, 2.0)] {
+            for k in [1, 2, 10, 64, 70] {
+                for metric in [Metric::Surface, Metric::Center] {
+                    let n = Nearest::new(q, k).metric(metric);
+                    let (mut got, mut want) = (Vec::new(), Vec::new());
+                    t.nearest_into(&n, None, &mut got).unwrap();
+                    brute.nearest_into(&n, None, &mut want).unwrap();
+                    let as_ids =
+                        |v: &[crate::broad::Neighbor], hs: &[Handle]| -> Vec<(usize, u32)> {
+                            v.iter()
+                                .map(|x| {
+                                    (
+                                        hs.iter().position(|&h| h == x.handle).unwrap(),
+                                        x.distance.to_bits(),
+                                    )
+                                })
+                                .collect()
+                        };
+                    assert_eq!(
+                        as_ids(&got, &ids.0),
+                        as_ids(&want, &ids.1),
+                        "{dups} {q:?} k {k}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -230,6 +230,10 @@ pub(crate) const LINEAR_MAX_K: usize = 32;
 /// its selection needs no allocation.
 pub(crate) const SEED_MAX: usize = 64;
 
+// `tighten_by_centres` keeps an index in 6 bits, the octree a leaf's seed
+// members in a `u64` mask.
+const _: () = assert!(SEED_MAX <= 64);
+
 /// The `k` best candidates seen so far inside the caller's output buffer: the
 /// bounded candidate set of the best-first and branch-and-bound searches. For
 /// `k <=` [`SORTED_MAX_K`] the buffer is kept in answer order
@@ -341,8 +345,9 @@ impl<'a> KBest<'a> {
     /// Lowers the limit from a first group of objects before the search
     /// offers them: `s2` holds the squared centre distances
     /// ([`overlap::point_point_distance_sq`]) of objects that are in the set
-    /// and pass the query's filter. If there are at least `k` of them, the
-    /// `k`-th smallest gives, by [`overlap::distance_at_most_from_sq`], a
+    /// and pass the query's filter. If there are at least `k` of them, `k`
+    /// of them (the `k` smallest; for `k <=` [`LINEAR_MAX_K`] up to 64 ulps)
+    /// give, by [`overlap::distance_at_most_from_sq`] of the largest, a
     /// distance `D` at or below which at least `k` objects lie in either
     /// metric (a surface distance never exceeds the centre distance), so the
     /// answer's `k`-th distance is at most `D` and nothing beyond `D` can
@@ -355,12 +360,13 @@ impl<'a> KBest<'a> {
     /// for `k > 32` takes a `max_per_leaf` above the default or the depth
     /// cap).
     ///
-    /// For `k <=` [`LINEAR_MAX_K`] it also writes into `first` the indices
-    /// (in `s2`) of the `k` values it bounds by, nearest first up to 64 ulps,
-    /// and returns `k` (else 0). Offered first and in that order, each
-    /// enters at the end of the sorted set: no insertion mispredicts where
-    /// it stops, as ~1.7 a candidate did in the leaf's order (callgrind, W7
-    /// points k = 10).
+    /// When `k <=` [`LINEAR_MAX_K`] and `k <= s2.len() <=` [`SEED_MAX`], it
+    /// also writes into `first[..k]` the indices (in `s2`) of the `k` values
+    /// it bounds by, by centre distance up to 64 ulps (ties by index), and
+    /// returns `k`; otherwise it returns 0 and leaves `first` alone. Offered
+    /// first and in that order, each mostly enters at the end of the sorted
+    /// set: no insertion mispredicts where it stops, as ~1.7 a candidate did
+    /// in the leaf's order (callgrind, W7 points k = 10).
     pub(crate) fn tighten_by_centres(
         &mut self,
         s2: &[f64],
@@ -388,11 +394,16 @@ impl<'a> KBest<'a> {
             // = 64; non-negative finite values order as their bits, so the
             // network orders the keys by the value, to 64 ulps, then the
             // index), and the bound is the largest exact value of the `k`
-            // taken: `k` values lie at or below it.
+            // taken: `k` values lie at or below it. The bits are also
+            // raised by one exponent step, which keeps their order and
+            // keeps a 0 (a point on the query) out of the subnormals: a
+            // host with denormals-are-zero on (a fast-math extension in
+            // the same Python process) would compare those keys equal, and
+            // the min/max could then take one index twice.
             let mut top = [f64::INFINITY; LINEAR_MAX_K];
             let k = self.k;
             for (i, &v) in s2.iter().enumerate() {
-                let x = f64::from_bits(v.to_bits() & !63 | i as u64);
+                let x = f64::from_bits((v.to_bits() & !63 | i as u64) + (1 << 52));
                 if x >= top[k - 1] {
                     continue;
                 }

@@ -575,11 +575,12 @@ fn child_halves_are_the_childrens_loose_boxes_bit_for_bit() {
 
 /// A leaf of `SEED_MAX` (64) items, past `max_per_leaf` at the depth cap,
 /// most of them duplicates at one point: the first leaf's seed lists the `k`
-/// it bounds by ahead of the other passers, and with every item passing the
-/// branch-free list writes one slot past the leaf's 64 (found while writing
-/// the seed order: a 64-slot list would panic at k = 1). Brute force's ids
-/// and distances, for k = 1, 2, 10, 64 and 70, from points on, beside and
-/// away from the duplicates, both metrics.
+/// it bounds by ahead of the other passers, and when those `k` include the
+/// leaf's last item and every item before it passes, the branch-free list
+/// writes one slot past the leaf's 64 (63 duplicates and the query off them,
+/// k = 2 or 10: a 64-slot list panicked here). Brute force's ids and
+/// distances, for k = 1, 2, 10, 64 and 70, from points on, beside and away
+/// from the duplicates, both metrics.
 #[test]
 fn nearest_over_a_full_leaf_of_duplicates_at_the_depth_cap() {
     use crate::broad::{BruteForce, Metric, Nearest};

@@ -313,14 +313,15 @@ impl<'a> KBest<'a> {
         s2 > self.mid_sq
     }
 
-    /// Whether a point whose [`overlap::point_point_distance_sq_f32`] is
-    /// `s2f` surely cannot enter as a centre (`Metric::Center`, or a zero
-    /// radius): then [`KBest::exceeds_sq`] holds for its `f64` squared
-    /// distance too ([`overlap::sq_threshold_f32`]). A pre-test: `false`
-    /// still needs the `f64` test. O(1).
+    /// The `f32` pre-test's threshold: a point whose `f32` squared distance
+    /// (`overlap::point_point_distance_sq_f32_4`, one lane) is above it
+    /// surely cannot enter as a centre (`Metric::Center`, or a zero radius):
+    /// then [`KBest::exceeds_sq`] holds for its `f64` squared distance too
+    /// ([`overlap::sq_threshold_f32`]). At or below it, the `f64` test
+    /// decides. O(1).
     #[inline]
-    pub(crate) fn exceeds_sq_f32(&self, s2f: f32) -> bool {
-        s2f > self.mid_sq_f32
+    pub(crate) fn sq_threshold_f32(&self) -> f32 {
+        self.mid_sq_f32
     }
 
     fn set_bound(&mut self, bound: f32) {
@@ -329,7 +330,7 @@ impl<'a> KBest<'a> {
     }
 
     /// Brings the pruning thresholds of [`KBest::exceeds`],
-    /// [`KBest::exceeds_sq`] and [`KBest::exceeds_sq_f32`] to the current
+    /// [`KBest::exceeds_sq`] and [`KBest::sq_threshold_f32`] to the current
     /// bound, after offers made with [`KBest::offer_unsynced`]. O(1).
     #[inline]
     pub(crate) fn sync(&mut self) {
@@ -840,7 +841,7 @@ mod tests {
                             assert!(!best.exceeds_sq(s2) || overlap::distance_exceeds(s2, 0.0, b));
                             assert!(!best.exceeds(s2, r) || overlap::distance_exceeds(s2, r, b));
                             assert!(
-                                !best.exceeds_sq_f32(s2 as f32)
+                                s2 as f32 <= best.sq_threshold_f32()
                                     || overlap::sq_threshold_f32(overlap::exceeds_threshold(
                                         overlap::distance_midpoint(b),
                                         0.0

@@ -838,10 +838,33 @@ pub fn point_point_distance_sq(p: Vec3, c: Vec3) -> f64 {
 /// value plus about `3·2^-150` for the products that underflow (`u = 2^-24`), or `∞`
 /// only when the exact value is above `f32::MAX·(1 - 4u)`; so whenever
 /// [`point_point_distance_sq`] is at most `t`, this is at most
-/// [`sq_threshold_f32`]`(t)`. O(1).
-#[inline]
+/// [`sq_threshold_f32`]`(t)`. O(1). The searches run it four lanes at a
+/// time ([`point_point_distance_sq_f32_4`]); this is its definition.
+#[cfg(test)]
 pub(crate) fn point_point_distance_sq_f32(p: Vec3, c: Vec3) -> f32 {
     let (x, y, z) = (c.x - p.x, c.y - p.y, c.z - p.z);
+    x * x + y * y + z * z
+}
+
+/// `|c - p|²` evaluated in `f32` from `p` to four centres at once, one per
+/// SIMD lane (the spheres' radii are ignored): three differences, three
+/// products, two sums, each rounded, in each lane the same operations in the
+/// same order as `point_point_distance_sq_f32`, hence the same value (test
+/// `f32_squared_distance_stays_within_its_threshold`). So whenever
+/// [`point_point_distance_sq`] is at most `t`, a lane is at most
+/// [`sq_threshold_f32`]`(t)`. O(1).
+#[inline(always)]
+pub(crate) fn point_point_distance_sq_f32_4(p: Vec3, s: [&Sphere; 4]) -> Vec4 {
+    // Rows (x, y, z, r) of the four spheres, transposed to one vector per
+    // coordinate.
+    let t =
+        glam::Mat4::from_cols_array_2d(&s.map(|s| [s.center.x, s.center.y, s.center.z, s.radius]))
+            .transpose();
+    let (x, y, z) = (
+        t.x_axis - Vec4::splat(p.x),
+        t.y_axis - Vec4::splat(p.y),
+        t.z_axis - Vec4::splat(p.z),
+    );
     x * x + y * y + z * z
 }
 
@@ -1488,6 +1511,13 @@ mod tests {
             }
             let t = point_point_distance_sq(p, c);
             let f = point_point_distance_sq_f32(p, c);
+            // The four-lane form, lane by lane, bit for bit.
+            let quad = [c, -c, c * 0.5, p].map(|c| Sphere::new(c, 0.0));
+            let lanes = point_point_distance_sq_f32_4(p, quad.each_ref()).to_array();
+            for (l, s) in lanes.iter().zip(&quad) {
+                let one = point_point_distance_sq_f32(p, s.center);
+                assert_eq!(l.to_bits(), one.to_bits(), "{p:?} {:?}", s.center);
+            }
             let th = sq_threshold_f32(t);
             assert!(f <= th, "{p:?} {c:?}: {f:e} > {th:e} (t {t:e})");
             let tight = t * (1.0 + 2f64.powi(-17)) + 2f64.powi(-125);

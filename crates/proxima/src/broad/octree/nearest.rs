@@ -8,7 +8,8 @@ use super::query::child_coords;
 use super::LinearOctree;
 use crate::broad::nearest::{KBest, Metric, Nearest, Neighbor, LINEAR_MAX_K, SEED_MAX};
 use crate::broad::Filter;
-use crate::geom::overlap;
+use crate::geom::{overlap, Sphere};
+use glam::Vec4;
 use std::cell::RefCell;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -189,9 +190,10 @@ impl<T> LinearOctree<T> {
         let metric = leaf_metric(n, q);
         // Indices of the items not surely beyond the bound, without a branch
         // per item.
-        // One more than a leaf's items: with the first `k` listed ahead, the
-        // branch-free loop below may write one slot past the last passer.
-        let mut pass = [0u8; SEED_MAX + 1];
+        // Four more than a leaf's items: with the first `k` listed ahead, the
+        // branch-free loop below may write one slot past the last passer,
+        // and four at a time up to four.
+        let mut pass = [0u8; SEED_MAX + 4];
         let mut m = 0;
         if best.is_empty() && filter.is_none() {
             let mut s2 = [0.0f64; SEED_MAX];
@@ -217,14 +219,34 @@ impl<T> LinearOctree<T> {
                 pass[m] = i as u8;
                 m += (!metric.excluded(d, &it.sphere, best) & (is_first >> i & 1 == 0)) as usize;
             }
-        } else if metric == Metric::Center {
+        } else if metric == Metric::Center && !items.is_empty() {
             // In `f32`: no conversions, and the passers' exact test below
-            // keeps the answer brute force's.
-            for (i, it) in items.iter().enumerate() {
-                let d = overlap::point_point_distance_sq_f32(q.point, it.sphere.center);
-                pass[m] = i as u8;
-                m += !best.exceeds_sq_f32(d) as usize;
+            // keeps the answer brute force's. Four items at a time, one per
+            // SIMD lane; their passers' positions are written four bytes at
+            // once from a table (`QUAD_PASSERS`). Against one item at a time
+            // (W7 points k = 10, `knn_leaf 100000 10 2000 32`, callgrind):
+            // 12.57k -> 11.89k instructions a query; probe median 2.24 ->
+            // 2.13 µs, faster in 13 of 16 alternations.
+            let t = Vec4::splat(best.sq_threshold_f32());
+            let mut quad = |from: usize, spheres: [&Sphere; 4], live: u32| {
+                let d = overlap::point_point_distance_sq_f32_4(q.point, spheres);
+                let bits = (!d.cmpgt(t).bitmask() & live) as usize;
+                let at = QUAD_PASSERS[bits] + from as u32 * 0x0101_0101;
+                pass[m..m + 4].copy_from_slice(&at.to_le_bytes());
+                m += QUAD_COUNT[bits] as usize;
+            };
+            let mut quads = items.chunks_exact(4);
+            let mut from = 0;
+            for c in &mut quads {
+                quad(from, [0, 1, 2, 3].map(|j| &c[j].sphere), 0xF);
+                from += 4;
             }
+            // The last 0-3 items as one more quad with its other lanes
+            // masked off: no loop whose length varies by leaf (its exit
+            // mispredicted about once a leaf).
+            let last = items.len() - 1;
+            let rest = [0, 1, 2, 3].map(|j| &items[(from + j).min(last)].sphere);
+            quad(from, rest, (1 << quads.remainder().len()) - 1);
         } else {
             for (i, it) in items.iter().enumerate() {
                 let d = overlap::point_point_distance_sq(q.point, it.sphere.center);
@@ -408,6 +430,29 @@ impl<T> LinearOctree<T> {
         }
     }
 }
+
+/// For each mask of four items, the positions of its set bits packed into
+/// the low bytes, in order (the rest 0).
+const QUAD_PASSERS: [u32; 16] = {
+    let mut t = [0u32; 16];
+    let mut bits = 0;
+    while bits < 16 {
+        let (mut j, mut at) = (0, 0);
+        while j < 4 {
+            if bits >> j & 1 == 1 {
+                t[bits] |= (j as u32) << (8 * at);
+                at += 1;
+            }
+            j += 1;
+        }
+        bits += 1;
+    }
+    t
+};
+
+/// The number of set bits of each mask of four (no `popcnt` in the
+/// baseline x86-64 target).
+const QUAD_COUNT: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
 
 /// The metric to measure leaf `n`'s items in: the query's, or
 /// [`Metric::Center`] when every item's radius is zero (the leaf's largest

@@ -148,6 +148,16 @@ pub(crate) trait Contact {
     /// Whether [`Contact::contact`] is `Some`, without computing it
     /// ([`overlap::ray_touches_sphere`], [`overlap::sweep_touches_sphere`]).
     fn touches(&self, s: &Sphere) -> bool;
+    /// Whether [`Contact::misses4`] is a real pre-test (else leaf scans
+    /// take the spheres one at a time).
+    const HAS_MISSES4: bool = false;
+    /// A mask of four spheres (bit `j` for `s[j]`) that [`Contact::contact`]
+    /// certainly finds `None` for, by a SIMD pre-test; 0 where a cast has
+    /// none. Leaf scans call it first.
+    #[inline(always)]
+    fn misses4(&self, _s: [&Sphere; 4]) -> u32 {
+        0
+    }
 }
 
 impl Contact for Ray {
@@ -169,6 +179,11 @@ impl Contact for SweepTest {
     #[inline]
     fn touches(&self, s: &Sphere) -> bool {
         SweepTest::touches(self, s)
+    }
+    const HAS_MISSES4: bool = true;
+    #[inline(always)]
+    fn misses4(&self, s: [&Sphere; 4]) -> u32 {
+        SweepTest::misses4(self, s)
     }
 }
 

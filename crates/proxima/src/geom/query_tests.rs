@@ -461,11 +461,13 @@ fn box_distance_bounds_the_spheres_inside() {
 /// side, of the start cap and of the end cap, at magnitudes from subnormal
 /// to 1e30 (centres far from the origin, long and short sweeps, tiny and
 /// zero radii, and mixed ones). It must also do its work: it rejects most
-/// clear misses of moderate inputs.
+/// clear misses of moderate inputs. Its four-lane form
+/// (`SweepTest::misses4`) answers each lane as it does.
 #[test]
 fn sweep_miss_pretest_is_conservative() {
     let mut rng = Pcg64::seed_from_u64(23);
     let (mut touched, mut rejected, mut clear, mut clear_rejected) = (0u32, 0u32, 0u32, 0u32);
+    let mut compared = 0u32;
     for k in 0..300_000 {
         let mut u = || rng.gen_range(-1.0f32..1.0);
         let (scale, offset, rscale) = match k % 6 {
@@ -519,6 +521,26 @@ fn sweep_miss_pretest_is_conservative() {
         rejected += miss as u32;
         // A clear miss (distance about twice the radii) of moderate inputs.
         let far = SphereSweep::new(from + side * (2.0 * rho), to + side * (2.0 * rho), rr);
+        // The four-lane pre-test answers each lane as the scalar one does:
+        // this sphere and three moved off the capsule by 0.5, 2 and 1e3
+        // radii (the last with a radius at the magnitude's scale), against
+        // both sweeps. One differing lane fails.
+        let quad = [
+            s,
+            Sphere::new(c + side * (0.5 * rho), r),
+            Sphere::new(c - side * (2.0 * rho), r),
+            Sphere::new(c + dir * (1e3 * rho), rscale * u().abs()),
+        ];
+        for sweep in [&sw, &far] {
+            let lanes = SweepTest::new(sweep).misses4(quad.each_ref());
+            for (j, q) in quad.iter().enumerate() {
+                if q.validate().is_ok() && sweep.validate().is_ok() {
+                    let scalar = sweep_sphere_misses(sweep, q);
+                    assert_eq!(lanes >> j & 1 == 1, scalar, "lane {j}: {sweep:?} {q:?}");
+                    compared += 1;
+                }
+            }
+        }
         if k % 6 == 0 && rho > 1e-3 && !sweep_touches_exact(&far, &s) {
             clear += 1;
             clear_rejected += sweep_sphere_misses(&far, &s) as u32;
@@ -526,6 +548,7 @@ fn sweep_miss_pretest_is_conservative() {
     }
     // Both sides of the boundary, and misses near it decided by the pre-test.
     assert!(touched > 50_000 && rejected > 3_000, "{touched} {rejected}");
+    assert!(compared > 1_000_000, "{compared} lanes compared");
     assert!(
         clear_rejected * 10 > clear * 9,
         "{clear_rejected} of {clear}"

@@ -2,7 +2,7 @@
 //! loose boxes, pruning every subtree the cast enters after the best hit found
 //! so far.
 
-use super::node::NONE;
+use super::node::{Item, NONE};
 use super::query::child_coords;
 use super::LinearOctree;
 use crate::broad::walk::{Cast, Contact};
@@ -63,32 +63,63 @@ impl<T> LinearOctree<T> {
             return;
         }
         if n.leaf {
-            for it in &n.items {
+            let offer = |it: &Item, best: &mut Option<RayHit>| {
                 if let Some(t) = test.contact(&it.sphere) {
                     if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
                         RayHit::offer(best, t, it.handle);
                     }
                 }
+            };
+            // Four at a time through the cast's SIMD pre-test, when it has
+            // one: the leaves' clear misses are most of a sweep's spheres
+            // (callgrind, `w8 --n 100000 --queries 5000 --reps 1 --check 0
+            // --only LinearOctree`: 16.2k -> 12.5k instructions a first-hit
+            // sweep).
+            let mut quads = n
+                .items
+                .chunks_exact(if X::HAS_MISSES4 { 4 } else { usize::MAX });
+            for q in &mut quads {
+                let mut live = !test.misses4([0, 1, 2, 3].map(|j| &q[j].sphere)) & 0xF;
+                while live != 0 {
+                    offer(&q[live.trailing_zeros() as usize], best);
+                    live &= live - 1;
+                }
+            }
+            for it in quads.remainder() {
+                offer(it, best);
             }
             return;
         }
         // The children's boxes from this node's extent: 12 slab parameters
         // for all 8, and no child node read before it is entered.
         let enters = entry.enter_octants(self.child_halves(n, c, d));
-        let mut order = [(0.0f32, 0u32, [0u32; 3]); 8];
+        // Front to back across the split planes by the direction's signs,
+        // not sorted by entry: the loose boxes overlap by the extent only,
+        // so the order is nearly the entry order, and the children entered
+        // are listed without a branch each. Against the sorted entries
+        // (callgrind, W8 as above): 12.5k -> 11.6k instructions and 92 ->
+        // 74 mispredicted branches a first-hit sweep. Any order finds the
+        // same hit; each child is tested against it on entry.
+        let near = entry.near_octant();
+        let mut order = [(0.0f32, 0usize); 8];
         let mut m = 0;
-        for (k, (&ch, ct0)) in n.children.iter().zip(enters).enumerate() {
-            if ch == NONE {
-                continue;
-            }
-            if let Some(ct0) = ct0 {
-                order[m] = (ct0, ch, child_coords(c, k));
-                m += 1;
-            }
+        for j in 0..8 {
+            let k = near ^ j;
+            order[m] = (enters[k].unwrap_or(f32::INFINITY), k);
+            m += (n.children[k] != NONE && enters[k].is_some()) as usize;
         }
-        order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        for &(ct0, ch, cc) in &order[..m] {
-            self.first_node(ch, cc, d + 1, ct0, test, entry, filter, best);
+        for &(ct0, k) in &order[..m] {
+            let ch = n.children[k];
+            self.first_node(
+                ch,
+                child_coords(c, k),
+                d + 1,
+                ct0,
+                test,
+                entry,
+                filter,
+                best,
+            );
         }
     }
 }

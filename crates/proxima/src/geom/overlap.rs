@@ -431,13 +431,7 @@ impl SweepTest {
         if !self.usable {
             return 0;
         }
-        // Rows (x, y, z, r) of the four spheres, transposed to one vector per
-        // coordinate.
-        let t = glam::Mat4::from_cols_array_2d(
-            &s.map(|s| [s.center.x, s.center.y, s.center.z, s.radius]),
-        )
-        .transpose();
-        let (cx, cy, cz, r) = (t.x_axis, t.y_axis, t.z_axis, t.w_axis);
+        let [cx, cy, cz, r] = sphere_lanes(s);
         let (f, to, d) = (self.sweep.from, self.sweep.to, self.d);
         let sp = Vec4::splat;
         let (dd, eps) = (sp(self.dd), sp(EPS));
@@ -913,17 +907,23 @@ pub(crate) fn point_point_distance_sq_f32(p: Vec3, c: Vec3) -> f32 {
 /// [`sq_threshold_f32`]`(t)`. O(1).
 #[inline(always)]
 pub(crate) fn point_point_distance_sq_f32_4(p: Vec3, s: [&Sphere; 4]) -> Vec4 {
-    // Rows (x, y, z, r) of the four spheres, transposed to one vector per
-    // coordinate.
+    let [cx, cy, cz, _] = sphere_lanes(s);
+    let (x, y, z) = (
+        cx - Vec4::splat(p.x),
+        cy - Vec4::splat(p.y),
+        cz - Vec4::splat(p.z),
+    );
+    x * x + y * y + z * z
+}
+
+/// Four spheres as SIMD lanes: their `x`, `y`, `z` and radii, one vector
+/// each (the rows `(x, y, z, r)` transposed, a few shuffles). O(1).
+#[inline(always)]
+fn sphere_lanes(s: [&Sphere; 4]) -> [Vec4; 4] {
     let t =
         glam::Mat4::from_cols_array_2d(&s.map(|s| [s.center.x, s.center.y, s.center.z, s.radius]))
             .transpose();
-    let (x, y, z) = (
-        t.x_axis - Vec4::splat(p.x),
-        t.y_axis - Vec4::splat(p.y),
-        t.z_axis - Vec4::splat(p.z),
-    );
-    x * x + y * y + z * z
+    [t.x_axis, t.y_axis, t.z_axis, t.w_axis]
 }
 
 /// The `f32` threshold for [`point_point_distance_sq_f32`] that keeps every

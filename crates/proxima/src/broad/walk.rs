@@ -153,7 +153,7 @@ pub(crate) trait Contact {
     const HAS_MISSES4: bool = false;
     /// A mask of four spheres (bit `j` for `s[j]`) that [`Contact::contact`]
     /// certainly finds `None` for, by a SIMD pre-test; 0 where a cast has
-    /// none. Leaf scans call it first.
+    /// none. The octree's first-hit leaf scan calls it first.
     #[inline(always)]
     fn misses4(&self, _s: [&Sphere; 4]) -> u32 {
         0

@@ -926,7 +926,8 @@ fn sphere_lanes(s: [&Sphere; 4]) -> [Vec4; 4] {
     [t.x_axis, t.y_axis, t.z_axis, t.w_axis]
 }
 
-/// The `f32` threshold for [`point_point_distance_sq_f32`] that keeps every
+/// The `f32` threshold for `point_point_distance_sq_f32` (and each lane of
+/// [`point_point_distance_sq_f32_4`]) that keeps every
 /// point whose [`point_point_distance_sq`] is at most `t` (a non-negative
 /// `f64`): `t` grown by `2^-18` relative (the `f32` sum's `5u` and the `f64`
 /// one's error, under `6·2^-53` even where its differences round, with room

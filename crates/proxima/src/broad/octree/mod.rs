@@ -374,8 +374,8 @@ impl<T> Walk<T> for LinearOctree<T> {
         self.nearest_tree(query, filter, out)
     }
 
-    /// Front-to-back: children in order of entry along the ray, subtrees entered
-    /// after the best hit so far skipped.
+    /// Front-to-back: children in the octant order of the ray's direction,
+    /// subtrees entered after the best hit so far skipped.
     fn first_hit(&self, ray: &Ray, filter: Option<Filter>) -> Option<RayHit> {
         self.first_tree(ray, filter)
     }

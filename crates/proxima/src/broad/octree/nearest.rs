@@ -225,8 +225,9 @@ impl<T> LinearOctree<T> {
             // SIMD lane; their passers' positions are written four bytes at
             // once from a table (`QUAD_PASSERS`). Against one item at a time
             // (W7 points k = 10, `knn_leaf 100000 10 2000 32`, callgrind):
-            // 12.57k -> 11.89k instructions a query; probe median 2.24 ->
-            // 2.13 µs, faster in 13 of 16 alternations.
+            // 12.57k -> 11.89k instructions a query; `knn_leaf 100000 10
+            // 50000 32` median 2.24 -> 2.13 µs, faster in 13 of 16
+            // alternations.
             let t = Vec4::splat(best.sq_threshold_f32());
             let mut quad = |from: usize, spheres: [&Sphere; 4], live: u32| {
                 let d = overlap::point_point_distance_sq_f32_4(q.point, spheres);

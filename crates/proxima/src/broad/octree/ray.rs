@@ -17,14 +17,17 @@ use crate::geom::overlap::EntryBound;
 const PRUNE_MARGIN: f32 = 1e-4;
 
 impl<T> LinearOctree<T> {
-    /// The contact of a ray or sweep with the smallest `(t, handle)`; children
-    /// are visited in order of the entry bound ([`Cast::entry`]) of their
-    /// cells grown by the parent's extent (`child_halves`: all 8 from 12 slab
-    /// parameters, [`EntryBound::enter_octants`], and no child read before it
-    /// is entered; callgrind, W8 first hit: 21.4k → 16.7k instructions a
-    /// sweep with the prepared sweep test). No allocation (≤ 8 children
-    /// sorted on the stack per level). Objects whose filter does not interact
-    /// with `filter` are skipped at the candidate.
+    /// The contact of a ray or sweep with the smallest `(t, handle)`; the
+    /// children a cast enters ([`Cast::entry`] of their cells grown by the
+    /// parent's extent: `child_halves`, all 8 from 12 slab parameters,
+    /// [`EntryBound::enter_octants`], no child read before it is entered)
+    /// are visited front to back in the octant order of the cast's
+    /// direction ([`EntryBound::near_octant`]), each skipped if entered after
+    /// the best hit so far. A leaf's spheres take the cast's four-wide
+    /// pre-test ([`Contact::misses4`]) where it has one (sweeps). No
+    /// allocation (≤ 8 children listed on the stack per level). Objects
+    /// whose filter does not interact with `filter` are skipped at the
+    /// candidate.
     pub(super) fn first_tree<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best = None;
         if !self.objects.is_empty() {

@@ -578,9 +578,11 @@ fn child_halves_are_the_childrens_loose_boxes_bit_for_bit() {
 /// it bounds by ahead of the other passers, and when those `k` include the
 /// leaf's last item and every item before it passes, the branch-free list
 /// writes one slot past the leaf's 64 (63 duplicates and the query off them,
-/// k = 2 or 10: a 64-slot list panicked here). Brute force's ids and
-/// distances, for k = 1, 2, 10, 64 and 70, from points on, beside and away
-/// from the duplicates, both metrics.
+/// k = 2 or 10: a 64-slot list panicked here). Filtered (a filter that
+/// admits all: no seed), a point cloud's leaf goes through the four-wide
+/// pre-test, whose last quad writes four slots from the 64th. Brute force's
+/// ids and distances, for k = 1, 2, 10, 64 and 70, from points on, beside
+/// and away from the duplicates, both metrics, with and without the filter.
 #[test]
 fn nearest_over_a_full_leaf_of_duplicates_at_the_depth_cap() {
     use crate::broad::{BruteForce, Metric, Nearest};
@@ -606,11 +608,15 @@ fn nearest_over_a_full_leaf_of_duplicates_at_the_depth_cap() {
         assert_eq!(largest, 64, "one leaf holds all 64");
         for q in [p, p + vec3(0.5, 0.0, 0.0), vec3(60.0, 1.0, 2.0)] {
             for k in [1, 2, 10, 64, 70] {
-                for metric in [Metric::Surface, Metric::Center] {
+                let metrics = [Metric::Surface, Metric::Center];
+                for (metric, filter) in metrics
+                    .into_iter()
+                    .flat_map(|m| [None, Some(crate::broad::Filter::ALL)].map(|f| (m, f)))
+                {
                     let n = Nearest::new(q, k).metric(metric);
                     let (mut got, mut want) = (Vec::new(), Vec::new());
-                    t.nearest_into(&n, None, &mut got).unwrap();
-                    brute.nearest_into(&n, None, &mut want).unwrap();
+                    t.nearest_into(&n, filter, &mut got).unwrap();
+                    brute.nearest_into(&n, filter, &mut want).unwrap();
                     let as_ids =
                         |v: &[crate::broad::Neighbor], hs: &[Handle]| -> Vec<(usize, u32)> {
                             v.iter()
@@ -625,7 +631,7 @@ fn nearest_over_a_full_leaf_of_duplicates_at_the_depth_cap() {
                     assert_eq!(
                         as_ids(&got, &ids.0),
                         as_ids(&want, &ids.1),
-                        "{dups} {q:?} k {k}"
+                        "{dups} {q:?} k {k} {filter:?}"
                     );
                 }
             }

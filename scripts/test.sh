@@ -51,7 +51,7 @@ VPY=$VENV/bin/python
 
 say "building the wheel"
 rm -rf "$PY_OUT/wheels"
-"$VENV/bin/maturin" build --release --strip --quiet \
+"$VENV/bin/maturin" build --profile wheel --strip --quiet \
     --manifest-path crates/proxima-py/Cargo.toml \
     --interpreter "$VPY" --out "$PY_OUT/wheels"
 "$VPY" -m pip install --quiet --disable-pip-version-check --no-deps --force-reinstall \

@@ -170,7 +170,7 @@ fn cuts_skip_the_volume_tests_above_them() {
     // hardest), nudged a little each frame: the traversal cut recorded at one
     // frame is where the next one starts.
     let m = Arc::new(rob());
-    let mut probe: World<u32> = World::new(WorldConfig {
+    let mut probe: World<u64> = World::new(WorldConfig {
         coherence: false,
         ..WorldConfig::default()
     })
@@ -204,7 +204,7 @@ fn cuts_skip_the_volume_tests_above_them() {
     let mut totals = [(0u64, 0u64, 0usize); 2];
     for (k, coherence) in [true, false].into_iter().enumerate() {
         let mut rng = Pcg64::seed_from_u64(4);
-        let mut w: World<u32> = World::new(WorldConfig {
+        let mut w: World<u64> = World::new(WorldConfig {
             coherence,
             cut_limit: 1024,
             ..WorldConfig::default()

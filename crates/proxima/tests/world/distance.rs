@@ -98,10 +98,10 @@ fn off_shape(o: &Obj, k: u32, p: DVec3) -> f64 {
 
 /// A random scene in a world with volume `BV`: meshes of every kind and balls,
 /// random and exact (touching) poses, some filters and ignored pairs.
-fn scene<BV: BoundingVolume>(seed: u64, n: usize, filters: bool) -> (World<u32, BV>, Vec<Obj>) {
+fn scene<BV: BoundingVolume>(seed: u64, n: usize, filters: bool) -> (World<u64, BV>, Vec<Obj>) {
     let mut rng = Pcg64::seed_from_u64(seed);
     let ms = meshes(&mut rng);
-    let mut world = World::<u32, BV>::new(WorldConfig::default()).unwrap();
+    let mut world = World::<u64, BV>::new(WorldConfig::default()).unwrap();
     let mut objs = Vec::new();
     for k in 0..n {
         let sh = match rng.gen_range(0..8) {
@@ -124,7 +124,7 @@ fn scene<BV: BoundingVolume>(seed: u64, n: usize, filters: bool) -> (World<u32, 
             Sh::Ball(r) => Shape::sphere(*r).unwrap(),
         };
         let h = world
-            .insert_with_filter(shape, pose, k as u32, filter)
+            .insert_with_filter(shape, pose, k as u64, filter)
             .unwrap();
         objs.push(Obj {
             h,
@@ -144,7 +144,7 @@ fn scene<BV: BoundingVolume>(seed: u64, n: usize, filters: bool) -> (World<u32, 
     (world, objs)
 }
 
-fn eligible<BV: BoundingVolume>(w: &World<u32, BV>, a: &Obj, b: &Obj) -> bool {
+fn eligible<BV: BoundingVolume>(w: &World<u64, BV>, a: &Obj, b: &Obj) -> bool {
     a.h != b.h && a.filter.interacts(b.filter) && !w.is_ignored(a.h, b.h).unwrap()
 }
 
@@ -269,7 +269,7 @@ fn nearest_obstacle_honours_filters_and_ignored_pairs() {
     }
     assert!(found > 150, "{found}");
     // A lone object, and one whose filter meets nobody's.
-    let mut w = World::<u32>::new(WorldConfig::default()).unwrap();
+    let mut w = World::<u64>::new(WorldConfig::default()).unwrap();
     let a = w
         .insert(Shape::sphere(1.0).unwrap(), Affine3A::IDENTITY, 0)
         .unwrap();

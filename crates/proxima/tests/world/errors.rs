@@ -165,7 +165,7 @@ fn bad_input_is_a_typed_error_and_changes_nothing() {
         ..WorldConfig::default()
     };
     assert!(matches!(
-        World::<u8>::new(cfg),
+        World::<u64>::new(cfg),
         Err(Error::InvalidParameter(_))
     ));
     let cfg = WorldConfig {
@@ -173,7 +173,7 @@ fn bad_input_is_a_typed_error_and_changes_nothing() {
         ..WorldConfig::default()
     };
     assert!(matches!(
-        World::<u8>::new(cfg),
+        World::<u64>::new(cfg),
         Err(Error::InvalidParameter(_))
     ));
     assert!(matches!(

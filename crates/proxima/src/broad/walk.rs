@@ -158,6 +158,12 @@ pub(crate) trait Contact {
     fn misses4(&self, _s: [&Sphere; 4]) -> u32 {
         0
     }
+    /// [`Contact::contact`] of a sphere that [`Contact::misses4`] left in:
+    /// a cast whose scalar test starts with the same pre-test skips it.
+    #[inline(always)]
+    fn contact_after_misses4(&self, s: &Sphere) -> Option<f32> {
+        self.contact(s)
+    }
 }
 
 impl Contact for Ray {
@@ -184,6 +190,10 @@ impl Contact for SweepTest {
     #[inline(always)]
     fn misses4(&self, s: [&Sphere; 4]) -> u32 {
         SweepTest::misses4(self, s)
+    }
+    #[inline(always)]
+    fn contact_after_misses4(&self, s: &Sphere) -> Option<f32> {
+        self.contact_undecided(s)
     }
 }
 

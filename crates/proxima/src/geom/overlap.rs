@@ -351,6 +351,14 @@ impl SweepTest {
         if self.misses(s) {
             return None;
         }
+        self.contact_undecided(s)
+    }
+
+    /// [`SweepTest::contact`] of a sphere whose pre-test already said
+    /// "undecided" ([`SweepTest::misses`] false, or its lane of
+    /// [`SweepTest::misses4`], which answers the same): the exact test only.
+    #[inline]
+    pub(crate) fn contact_undecided(&self, s: &Sphere) -> Option<f32> {
         first_touch(&SweepBall {
             sweep: &self.sweep,
             s,

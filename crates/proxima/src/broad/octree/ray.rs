@@ -24,7 +24,9 @@ impl<T> LinearOctree<T> {
     /// are visited front to back in the octant order of the cast's
     /// direction ([`EntryBound::near_octant`]), each skipped if entered after
     /// the best hit so far. A leaf's spheres take the cast's four-wide
-    /// pre-test ([`Contact::misses4`]) where it has one (sweeps). No
+    /// pre-test ([`Contact::misses4`]) where it has one (sweeps), and those
+    /// it leaves in go straight to the exact test
+    /// ([`Contact::contact_after_misses4`]). No
     /// allocation (≤ 8 children listed on the stack per level). Objects
     /// whose filter does not interact with `filter` are skipped at the
     /// candidate.
@@ -66,8 +68,8 @@ impl<T> LinearOctree<T> {
             return;
         }
         if n.leaf {
-            let offer = |it: &Item, best: &mut Option<RayHit>| {
-                if let Some(t) = test.contact(&it.sphere) {
+            let offer = |t: Option<f32>, it: &Item, best: &mut Option<RayHit>| {
+                if let Some(t) = t {
                     if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
                         RayHit::offer(best, t, it.handle);
                     }
@@ -84,12 +86,14 @@ impl<T> LinearOctree<T> {
             for q in &mut quads {
                 let mut live = !test.misses4([0, 1, 2, 3].map(|j| &q[j].sphere)) & 0xF;
                 while live != 0 {
-                    offer(&q[live.trailing_zeros() as usize], best);
+                    // Its lane ran the scalar pre-test already.
+                    let it = &q[live.trailing_zeros() as usize];
+                    offer(test.contact_after_misses4(&it.sphere), it, best);
                     live &= live - 1;
                 }
             }
             for it in quads.remainder() {
-                offer(it, best);
+                offer(test.contact(&it.sphere), it, best);
             }
             return;
         }

@@ -44,6 +44,28 @@ pub trait Selection: sealed::Sealed {
         self.selects(s)
     }
 
+    /// Whether [`Selection::rejects4`] is a real pre-test (else leaf scans
+    /// take the spheres one at a time).
+    const HAS_REJECTS4: bool = false;
+
+    /// A mask of four stored spheres (bit `j` for `s[j]`) that
+    /// [`Selection::selects`] certainly rejects, by a SIMD pre-test; 0 where
+    /// the query has none (the default). The octree's leaf scans call it
+    /// first where [`Selection::HAS_REJECTS4`] says it is real (sweeps).
+    #[inline(always)]
+    fn rejects4(&self, s: [&Sphere; 4]) -> u32 {
+        let _ = s;
+        0
+    }
+
+    /// [`Selection::selects`] of a sphere that [`Selection::rejects4`] left
+    /// in: a query whose exact test starts with the same pre-test skips it.
+    /// Same answer as `selects`.
+    #[inline(always)]
+    fn selects_after_rejects4(&self, s: &Sphere) -> bool {
+        self.selects(s)
+    }
+
     /// Conservative box test over the planes in `mask` (only frustums use the mask:
     /// others pass it through). Returns the relation and the mask for the children.
     fn classify_box(&self, b: &Aabb, mask: u8) -> (Relation, u8);
@@ -283,6 +305,15 @@ impl<C: Cast> Selection for Prepared<'_, C> {
     #[inline]
     fn selects(&self, s: &Sphere) -> bool {
         self.test.touches(s)
+    }
+    const HAS_REJECTS4: bool = <C::Test as Contact>::HAS_MISSES4;
+    #[inline(always)]
+    fn rejects4(&self, s: [&Sphere; 4]) -> u32 {
+        self.test.misses4(s)
+    }
+    #[inline(always)]
+    fn selects_after_rejects4(&self, s: &Sphere) -> bool {
+        self.test.touches_after_misses4(s)
     }
     #[inline]
     fn classify_box(&self, b: &Aabb, mask: u8) -> (Relation, u8) {

@@ -164,6 +164,12 @@ pub(crate) trait Contact {
     fn contact_after_misses4(&self, s: &Sphere) -> Option<f32> {
         self.contact(s)
     }
+    /// [`Contact::touches`] of a sphere that [`Contact::misses4`] left in,
+    /// as [`Contact::contact_after_misses4`].
+    #[inline(always)]
+    fn touches_after_misses4(&self, s: &Sphere) -> bool {
+        self.touches(s)
+    }
 }
 
 impl Contact for Ray {
@@ -194,6 +200,10 @@ impl Contact for SweepTest {
     #[inline(always)]
     fn contact_after_misses4(&self, s: &Sphere) -> Option<f32> {
         self.contact_undecided(s)
+    }
+    #[inline(always)]
+    fn touches_after_misses4(&self, s: &Sphere) -> bool {
+        self.touches_undecided(s)
     }
 }
 

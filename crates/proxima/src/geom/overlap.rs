@@ -368,11 +368,18 @@ impl SweepTest {
     /// [`sweep_touches_sphere`] of the prepared sweep and `s`.
     #[inline]
     pub(crate) fn touches(&self, s: &Sphere) -> bool {
-        !self.misses(s)
-            && touches(&SweepBall {
-                sweep: &self.sweep,
-                s,
-            })
+        !self.misses(s) && self.touches_undecided(s)
+    }
+
+    /// [`SweepTest::touches`] of a sphere whose pre-test already said
+    /// "undecided" (as for [`SweepTest::contact_undecided`]): the exact test
+    /// only.
+    #[inline]
+    pub(crate) fn touches_undecided(&self, s: &Sphere) -> bool {
+        touches(&SweepBall {
+            sweep: &self.sweep,
+            s,
+        })
     }
 
     /// Conservative `f32` pre-test of [`sweep_sphere`]: `true` only if the sweep

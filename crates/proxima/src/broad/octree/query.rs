@@ -2,7 +2,7 @@
 //! ([sources: octree-cull]: classify cells against the frustum as outside / inside /
 //! intersecting).
 
-use super::node::NONE;
+use super::node::{Item, NONE};
 use super::LinearOctree;
 use crate::broad::filter::Admit;
 use crate::broad::Selection;
@@ -23,7 +23,8 @@ pub(super) fn child_coords(c: [u32; 3], k: usize) -> [u32; 3] {
 impl<T> LinearOctree<T> {
     /// Traverses the tree for `q`. A node's loose box is classified once: `Outside`
     /// prunes the subtree, `Inside` reports it whole without testing its spheres,
-    /// `Intersecting` goes on (a leaf tests each sphere with `q.selects`). The plane
+    /// `Intersecting` goes on (a leaf tests each sphere with `q.selects`, after
+    /// [`Selection::rejects4`] four at a time where the query has it). The plane
     /// mask returned for a node is what its children are tested against, so a
     /// frustum plane that contains a parent is never tested again below it.
     /// Recursion depth ≤ 22; no allocation.
@@ -69,12 +70,33 @@ impl<T> LinearOctree<T> {
             Relation::Inside => self.report_all(i, admit, f),
             Relation::Intersecting => {
                 if n.leaf {
-                    for it in &n.items {
-                        if q.selects(&it.sphere) {
-                            let o = self.obj(it.handle);
-                            if admit.object(o.filter) {
-                                f(it.handle, &it.sphere, &o.value)?;
+                    let mut report = |it: &Item| {
+                        let o = self.obj(it.handle);
+                        if admit.object(o.filter) {
+                            f(it.handle, &it.sphere, &o.value)?;
+                        }
+                        ControlFlow::Continue(())
+                    };
+                    // Four at a time through the query's SIMD pre-test where
+                    // it has one (sweeps), as the first-hit search does; the
+                    // spheres it leaves in take the exact test only, in the
+                    // leaf's order.
+                    let mut quads =
+                        n.items
+                            .chunks_exact(if Q::HAS_REJECTS4 { 4 } else { usize::MAX });
+                    for quad in &mut quads {
+                        let mut live = !q.rejects4([0, 1, 2, 3].map(|j| &quad[j].sphere)) & 0xF;
+                        while live != 0 {
+                            let it = &quad[live.trailing_zeros() as usize];
+                            if q.selects_after_rejects4(&it.sphere) {
+                                report(it)?;
                             }
+                            live &= live - 1;
+                        }
+                    }
+                    for it in quads.remainder() {
+                        if q.selects(&it.sphere) {
+                            report(it)?;
                         }
                     }
                 } else {

@@ -118,9 +118,10 @@ impl DerefMut for Named {
 /// A stored payload as the runner's id. The indices hold `u64` payloads, as
 /// the oracle and the replay engine do: each payload type builds all six
 /// indices again, and a second one (`u32`) made this crate the longest unit
-/// of CI's build after the world tests. The ids fit in `u32`.
+/// of CI's build after the world tests. Every payload is a `u32` id widened
+/// (`next_id.into()`), so a wider one is a bug.
 fn id(x: u64) -> u32 {
-    x as u32
+    u32::try_from(x).expect("a payload is a u32 id")
 }
 
 fn ids(r: Result<ControlFlow<()>>, mut v: Vec<u32>) -> Result<Vec<u32>> {

@@ -153,7 +153,8 @@ pub(crate) trait Contact {
     const HAS_MISSES4: bool = false;
     /// A mask of four spheres (bit `j` for `s[j]`) that [`Contact::contact`]
     /// certainly finds `None` for, by a SIMD pre-test; 0 where a cast has
-    /// none. The octree's first-hit leaf scan calls it first.
+    /// none. The octree's leaf scans call it first: its first-hit search,
+    /// and its selection walk through [`Selection::rejects4`](super::Selection::rejects4).
     #[inline(always)]
     fn misses4(&self, _s: [&Sphere; 4]) -> u32 {
         0

@@ -356,7 +356,9 @@ impl SweepTest {
 
     /// [`SweepTest::contact`] of a sphere whose pre-test already said
     /// "undecided" ([`SweepTest::misses`] false, or its lane of
-    /// [`SweepTest::misses4`], which answers the same): the exact test only.
+    /// [`SweepTest::misses4`]): the exact test only. Equal to `contact` on
+    /// every sphere whatever a pre-test said, since the pre-test is
+    /// conservative (it says "miss" only where the exact test does).
     #[inline]
     pub(crate) fn contact_undecided(&self, s: &Sphere) -> Option<f32> {
         first_touch(&SweepBall {
@@ -439,7 +441,8 @@ impl SweepTest {
     /// `length_squared` written out), so it rounds the same and answers the
     /// same (test `sweep_miss_pretest_is_conservative` compares every lane);
     /// the three early returns become one mask. What it saves: the leaves'
-    /// clear misses are most of a first-hit sweep's spheres.
+    /// clear misses are most of the spheres a sweep's walks test (first hit
+    /// and all hits).
     #[inline(always)]
     pub(crate) fn misses4(&self, s: [&Sphere; 4]) -> u32 {
         const EPS: f32 = 1.0 / 65536.0; // 2^-16

@@ -23,8 +23,9 @@ pub(super) fn child_coords(c: [u32; 3], k: usize) -> [u32; 3] {
 impl<T> LinearOctree<T> {
     /// Traverses the tree for `q`. A node's loose box is classified once: `Outside`
     /// prunes the subtree, `Inside` reports it whole without testing its spheres,
-    /// `Intersecting` goes on (a leaf tests each sphere with `q.selects`, after
-    /// [`Selection::rejects4`] four at a time where the query has it). The plane
+    /// `Intersecting` goes on (a leaf tests each sphere with `q.selects`; where
+    /// the query has [`Selection::rejects4`], four at a time through it first,
+    /// and the spheres it leaves in with `q.selects_after_rejects4`). The plane
     /// mask returned for a node is what its children are tested against, so a
     /// frustum plane that contains a parent is never tested again below it.
     /// Recursion depth ≤ 22; no allocation.

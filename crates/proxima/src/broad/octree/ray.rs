@@ -86,7 +86,8 @@ impl<T> LinearOctree<T> {
             for q in &mut quads {
                 let mut live = !test.misses4([0, 1, 2, 3].map(|j| &q[j].sphere)) & 0xF;
                 while live != 0 {
-                    // Its lane ran the scalar pre-test already.
+                    // Its lane ran the pre-test already (conservative, so
+                    // the exact test alone gives `contact`'s answer).
                     let it = &q[live.trailing_zeros() as usize];
                     offer(test.contact_after_misses4(&it.sphere), it, best);
                     live &= live - 1;

@@ -638,3 +638,100 @@ fn nearest_over_a_full_leaf_of_duplicates_at_the_depth_cap() {
         }
     }
 }
+
+/// Sweep selections (all hits) and first hits against brute force over
+/// leaves of every size, so that the four-wide pre-test's quads and its
+/// remainder of 0-3 spheres both run: random sweeps, zero-length ones, radius
+/// 0, grazes at the summed radii from a stored sphere, and an early stop.
+#[test]
+fn sweeps_over_leaves_of_every_size_match_brute_force() {
+    use crate::geom::{overlap, SphereSweep};
+    use std::ops::ControlFlow;
+    let mut rng = Pcg64::seed_from_u64(91);
+    let mut p = |rng: &mut Pcg64| vec3(rng.gen(), rng.gen(), rng.gen()) * 64.0;
+    for leaf in [1u32, 3, 4, 5, 6, 7, 9, 32] {
+        let mut t = LinearOctree::with_config(cfg(leaf, leaf / 2, 21)).unwrap();
+        let mut spheres = Vec::new();
+        for i in 0..1500usize {
+            let s = Sphere::new(p(&mut rng), rng.gen_range(0.0..2.0));
+            t.insert(s, i).unwrap();
+            spheres.push(s);
+        }
+        t.validate().unwrap();
+        let (mut hits, mut firsts) = (0, 0);
+        for j in 0..600 {
+            let radius = if j % 3 == 0 {
+                0.0
+            } else {
+                rng.gen_range(0.0..3.0)
+            };
+            let from = p(&mut rng);
+            let to = match j % 4 {
+                0 => from,
+                1 => {
+                    // Past a stored sphere at the summed radii (a graze,
+                    // up to rounding either way).
+                    let s = spheres[rng.gen_range(0..spheres.len())];
+                    let u = (p(&mut rng) - Vec3::splat(32.0)).normalize_or(Vec3::X);
+                    let n = u.any_orthonormal_vector();
+                    let mid = s.center + n * (s.radius + radius);
+                    let sw_from = mid - u * 5.0;
+                    let sw = SphereSweep::new(sw_from, mid + u * 5.0, radius);
+                    check_sweep(&t, &spheres, &sw, &mut hits, &mut firsts);
+                    continue;
+                }
+                _ => from + (p(&mut rng) - Vec3::splat(32.0)) * rng.gen_range(0.05..0.5),
+            };
+            check_sweep(
+                &t,
+                &spheres,
+                &SphereSweep::new(from, to, radius),
+                &mut hits,
+                &mut firsts,
+            );
+        }
+        assert!(
+            hits > 400 && firsts > 150,
+            "leaf {leaf}: {hits} hits, {firsts} firsts"
+        );
+    }
+
+    fn check_sweep(
+        t: &LinearOctree<usize>,
+        spheres: &[Sphere],
+        sw: &SphereSweep,
+        hits: &mut usize,
+        firsts: &mut usize,
+    ) {
+        let mut got = Vec::new();
+        t.for_each_in(*sw, |_, _, &i| {
+            got.push(i);
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+        got.sort_unstable();
+        let want: Vec<usize> = (0..spheres.len())
+            .filter(|&i| overlap::sweep_touches_sphere(sw, &spheres[i]))
+            .collect();
+        assert_eq!(got, want, "{sw:?}");
+        *hits += got.len();
+        let mut seen = 0;
+        t.for_each_in(*sw, |_, _, _| {
+            seen += 1;
+            ControlFlow::Break(())
+        })
+        .unwrap();
+        assert_eq!(seen, want.len().min(1), "early stop, {sw:?}");
+        let want_t = spheres
+            .iter()
+            .filter_map(|s| overlap::sweep_sphere(sw, s))
+            .min_by(f32::total_cmp);
+        let first = t.sweep_first(sw, None).unwrap();
+        assert_eq!(first.map(|h| h.t), want_t, "{sw:?}");
+        if let Some(h) = first {
+            let i = *t.get(h.handle).unwrap().1;
+            assert_eq!(overlap::sweep_sphere(sw, &spheres[i]), Some(h.t), "{sw:?}");
+            *firsts += 1;
+        }
+    }
+}

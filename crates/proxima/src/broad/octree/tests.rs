@@ -648,7 +648,7 @@ fn sweeps_over_leaves_of_every_size_match_brute_force() {
     use crate::geom::{overlap, SphereSweep};
     use std::ops::ControlFlow;
     let mut rng = Pcg64::seed_from_u64(91);
-    let mut p = |rng: &mut Pcg64| vec3(rng.gen(), rng.gen(), rng.gen()) * 64.0;
+    let p = |rng: &mut Pcg64| vec3(rng.gen(), rng.gen(), rng.gen()) * 64.0;
     for leaf in [1u32, 3, 4, 5, 6, 7, 9, 32] {
         let mut t = LinearOctree::with_config(cfg(leaf, leaf / 2, 21)).unwrap();
         let mut spheres = Vec::new();
@@ -704,11 +704,11 @@ fn sweeps_over_leaves_of_every_size_match_brute_force() {
         firsts: &mut usize,
     ) {
         let mut got = Vec::new();
-        t.for_each_in(*sw, |_, _, &i| {
+        let flow = t.for_each_in(*sw, |_, _, &i| {
             got.push(i);
             ControlFlow::Continue(())
-        })
-        .unwrap();
+        });
+        assert_eq!(flow, Ok(ControlFlow::Continue(())));
         got.sort_unstable();
         let want: Vec<usize> = (0..spheres.len())
             .filter(|&i| overlap::sweep_touches_sphere(sw, &spheres[i]))
@@ -716,11 +716,16 @@ fn sweeps_over_leaves_of_every_size_match_brute_force() {
         assert_eq!(got, want, "{sw:?}");
         *hits += got.len();
         let mut seen = 0;
-        t.for_each_in(*sw, |_, _, _| {
+        let flow = t.for_each_in(*sw, |_, _, _| {
             seen += 1;
             ControlFlow::Break(())
-        })
-        .unwrap();
+        });
+        let stopped = if want.is_empty() {
+            ControlFlow::Continue(())
+        } else {
+            ControlFlow::Break(())
+        };
+        assert_eq!(flow, Ok(stopped), "early stop, {sw:?}");
         assert_eq!(seen, want.len().min(1), "early stop, {sw:?}");
         let want_t = spheres
             .iter()

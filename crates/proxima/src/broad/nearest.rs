@@ -450,6 +450,52 @@ impl<'a> KBest<'a> {
         self.sync();
     }
 
+    /// [`KBest::offer_unsynced`] of each of `group` in turn, into a set that
+    /// holds nothing yet, for a group that mostly comes in answer order
+    /// already: the `k` a search bounded by ([`KBest::tighten_by_centres`],
+    /// nearest first up to 64 ulps of their squared distances). Those
+    /// within the limit are appended (at most `k`), and sorted only if they
+    /// are out of order (ties by handle, or two distances the 64 ulps
+    /// swapped): the same set, in the same order, as offering them one by
+    /// one, without the insertion step of each. O(len) in order, else
+    /// O(len log len). Sound on any group of distinct candidates, in any
+    /// order (tested against offers).
+    pub(crate) fn seed_unsynced(&mut self, group: impl IntoIterator<Item = Neighbor>) {
+        debug_assert!(self.held.is_empty());
+        if self.k == 0 {
+            return;
+        }
+        for n in group {
+            if n.distance <= self.limit {
+                self.held.push(n);
+            }
+        }
+        let h = &mut *self.held;
+        // Strictly rising distances are in answer order; anything else
+        // (ties, mostly) is sorted. No branch per entry.
+        let mut rising = true;
+        for w in h.windows(2) {
+            rising &= w[0].distance < w[1].distance;
+        }
+        if !rising {
+            h.sort_unstable_by(Neighbor::order);
+        }
+        if h.len() > self.k {
+            h.truncate(self.k);
+        }
+        if !self.sorted {
+            // The heap representation keeps its worst first.
+            h.reverse();
+        }
+        if h.len() == self.k {
+            self.bound = if self.sorted {
+                h[self.k - 1].distance
+            } else {
+                h[0].distance
+            };
+        }
+    }
+
     /// [`KBest::offer`] that updates [`KBest::bound`] but leaves the pruning
     /// thresholds at an earlier bound until [`KBest::sync`]: for a group of
     /// offers in a row, which need only the bound. Until then the
@@ -764,6 +810,7 @@ pub(crate) fn grow_box(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::seq::SliceRandom;
     use rand::{Rng, SeedableRng};
 
     fn neighbor(index: u32, distance: f32) -> Neighbor {
@@ -869,6 +916,69 @@ mod tests {
                 all.truncate(k);
                 assert_eq!(out, all, "k={k} limit {limit}");
             }
+        }
+    }
+
+    /// `seed_unsynced` leaves the set exactly as offering its group one by
+    /// one does (entries, their order or heap layout's answer, bound, and
+    /// what later offers do), on groups of distinct handles dense in tied
+    /// and one-ulp-apart distances, in order, nearly in order and shuffled,
+    /// shorter and longer than `k`, with and without a limit, for `k` on
+    /// both sides of the sorted/heap switch.
+    #[test]
+    fn seed_unsynced_is_offering_one_by_one() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(15);
+        let ds = [0.0f32, 1.0, 1.0 + f32::EPSILON, 2.0, 3.0];
+        for round in 0..3000 {
+            let k = [1, 2, 5, 10, LINEAR_MAX_K, 40, SORTED_MAX_K + 3][round % 7];
+            let limit = [f32::INFINITY, 1.0 + f32::EPSILON, 0.0][round % 3];
+            let len = rng.gen_range(0..=k + 4);
+            let mut handles: Vec<u32> = (0..600).collect();
+            handles.shuffle(&mut rng);
+            let mut group: Vec<Neighbor> = handles[..len]
+                .iter()
+                .map(|&i| {
+                    let d = if rng.gen_bool(0.5) {
+                        ds[rng.gen_range(0..ds.len())]
+                    } else {
+                        rng.gen_range(0.0f32..3.0)
+                    };
+                    neighbor(i, d)
+                })
+                .collect();
+            match round % 3 {
+                0 => group.sort_unstable_by(Neighbor::order),
+                1 => {
+                    group.sort_unstable_by(|a, b| a.distance.total_cmp(&b.distance));
+                    if len > 1 {
+                        let i = rng.gen_range(0..len - 1);
+                        group.swap(i, i + 1);
+                    }
+                }
+                _ => {}
+            }
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            let mut seeded = KBest::new(&mut a, k, limit);
+            let mut offered = KBest::new(&mut b, k, limit);
+            seeded.seed_unsynced(group.iter().copied());
+            for &n in &group {
+                offered.offer_unsynced(n);
+            }
+            assert_eq!(
+                seeded.bound().to_bits(),
+                offered.bound().to_bits(),
+                "round {round}"
+            );
+            // Later offers see the same set.
+            for _ in 0..4 {
+                let n = neighbor(rng.gen_range(600..660), ds[rng.gen_range(0..ds.len())]);
+                seeded.offer(n);
+                offered.offer(n);
+                assert_eq!(seeded.bound().to_bits(), offered.bound().to_bits());
+            }
+            seeded.finish();
+            offered.finish();
+            assert_eq!(a, b, "round {round}: k {k}, limit {limit}, {group:?}");
         }
     }
 

@@ -84,9 +84,9 @@ impl<T> LinearOctree<T> {
     /// are pruned against a near-final bound and few candidates are
     /// inserted only to be evicted. The depth-first search reaches that leaf
     /// first, straight down the nearest octants, and orders a node's other
-    /// children only on the way back up, against its bound. Octants are searched nearest first (up
-    /// to rounding, `octants_nearest_first`; each tested against the bound
-    /// when its turn comes), or from
+    /// children only on the way back up, against its bound. Octants are
+    /// searched nearest first (up to rounding, `octants_nearest_first`; each
+    /// tested against the bound when its turn comes), or from
     /// `BEST_FIRST_MIN_K` answers on all pending nodes nearest first (a
     /// per-thread frontier heap). The filter is checked at each
     /// candidate that could enter. No allocation once `out` holds `k` entries.
@@ -179,9 +179,9 @@ impl<T> LinearOctree<T> {
     /// from the same squared distances before anything is offered
     /// (`KBest::tighten_by_centres`), and offers the `k` it bounds by first,
     /// nearest first, as one block (`KBest::seed_unsynced`: 0.35k fewer
-    /// instructions a query than offering each, W7 points k = 10). Leaves over
-    /// `SEED_MAX` items (only at the depth cap) go one item at a time. Both
-    /// searches take this step.
+    /// instructions a query than offering each, W7 points k = 10). Leaves
+    /// over `SEED_MAX` items (only at the depth cap) go one item at a time.
+    /// Both searches take this step.
     /// Always inlined: as a call from the depth-first recursion it cost 4%
     /// more instructions at k = 10 (callgrind, W7 points).
     #[inline(always)]

@@ -240,7 +240,8 @@ const _: () = assert!(SEED_MAX <= 64);
 /// ([`Neighbor::order`]), beyond it as a max-heap (worst first). It also keeps
 /// the pruning threshold of its bound ([`overlap::distance_midpoint`]), which
 /// changes only when a candidate enters (or, after
-/// [`KBest::offer_unsynced`], at [`KBest::sync`]), so the per-candidate and per-node
+/// [`KBest::offer_unsynced`] or [`KBest::seed_unsynced`], at [`KBest::sync`]),
+/// so the per-candidate and per-node
 /// tests ([`KBest::exceeds`], [`KBest::exceeds_sq`]) are one or two flops and
 /// a comparison. No allocation once the buffer holds `k` entries.
 pub(crate) struct KBest<'a> {
@@ -364,10 +365,11 @@ impl<'a> KBest<'a> {
     /// When `k <=` [`LINEAR_MAX_K`] and `k <= s2.len() <=` [`SEED_MAX`], it
     /// also writes into `first[..k]` the indices (in `s2`) of the `k` values
     /// it bounds by, by centre distance up to 64 ulps (ties by index), and
-    /// returns `k`; otherwise it returns 0 and leaves `first` alone. Offered
-    /// first and in that order, each mostly enters at the end of the sorted
-    /// set: no insertion mispredicts where it stops, as ~1.7 a candidate did
-    /// in the leaf's order (callgrind, W7 points k = 10).
+    /// returns `k`; otherwise it returns 0 and leaves `first` alone. In that
+    /// order they are mostly in answer order already, so
+    /// [`KBest::seed_unsynced`] takes them as one block and rarely sorts
+    /// (offered one by one in the leaf's order, each insertion had
+    /// mispredicted ~1.7 times, callgrind, W7 points k = 10).
     pub(crate) fn tighten_by_centres(
         &mut self,
         s2: &[f64],
@@ -454,12 +456,16 @@ impl<'a> KBest<'a> {
     /// holds nothing yet, for a group that mostly comes in answer order
     /// already: the `k` a search bounded by ([`KBest::tighten_by_centres`],
     /// nearest first up to 64 ulps of their squared distances). Those
-    /// within the limit are appended (at most `k`), and sorted only if they
-    /// are out of order (ties by handle, or two distances the 64 ulps
-    /// swapped): the same set, in the same order, as offering them one by
-    /// one, without the insertion step of each. O(len) in order, else
-    /// O(len log len). Sound on any group of distinct candidates, in any
-    /// order (tested against offers).
+    /// within the limit are appended, sorted only if their distances are
+    /// not strictly rising (ties by handle, signed zeros, or two distances
+    /// the 64 ulps swapped), and cut to the first `k`: the same set as
+    /// offering them one by one (in the same order when sorted, `k <=`
+    /// [`SORTED_MAX_K`]; as a heap above it, the same answer after
+    /// [`KBest::finish`]), without the insertion step of each. A group
+    /// longer than `k` may grow the buffer past `k` entries for a moment
+    /// (the searches pass exactly `k`). O(len) in order, else O(len log
+    /// len). Sound on any group of distinct candidates, in any order (tested
+    /// against offers).
     pub(crate) fn seed_unsynced(&mut self, group: impl IntoIterator<Item = Neighbor>) {
         debug_assert!(self.held.is_empty());
         if self.k == 0 {
@@ -928,11 +934,18 @@ mod tests {
     #[test]
     fn seed_unsynced_is_offering_one_by_one() {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(15);
-        let ds = [0.0f32, 1.0, 1.0 + f32::EPSILON, 2.0, 3.0];
-        for round in 0..3000 {
+        let ds = [-0.0f32, 0.0, 1.0, 1.0 + f32::EPSILON, 2.0, 3.0];
+        for round in 0..6000 {
             let k = [1, 2, 5, 10, LINEAR_MAX_K, 40, SORTED_MAX_K + 3][round % 7];
-            let limit = [f32::INFINITY, 1.0 + f32::EPSILON, 0.0][round % 3];
-            let len = rng.gen_range(0..=k + 4);
+            // Independent of the group's order below (round % 3).
+            let limit = [f32::INFINITY, 1.0 + f32::EPSILON, 0.0][round / 7 % 3];
+            // Half the heap rounds fill the set (a wrong heap layout shows
+            // only then).
+            let len = if k > SORTED_MAX_K && rng.gen_bool(0.5) {
+                rng.gen_range(k..=k + 4)
+            } else {
+                rng.gen_range(0..=k + 4)
+            };
             let mut handles: Vec<u32> = (0..600).collect();
             handles.shuffle(&mut rng);
             let mut group: Vec<Neighbor> = handles[..len]

@@ -83,10 +83,11 @@ impl<T> LinearOctree<T> {
     /// unfiltered queries), so later leaves
     /// are pruned against a near-final bound and few candidates are
     /// inserted only to be evicted. The depth-first search reaches that leaf
-    /// first, straight down the nearest octants, and orders a node's other
-    /// children only on the way back up, against its bound. Octants are
-    /// searched nearest first (up to rounding, `octants_nearest_first`; each
-    /// tested against the bound when its turn comes), or from
+    /// first, straight down the nearest octants (a node whose nearest child
+    /// is absent orders all its children at once), and orders a node's
+    /// other children only on the way back up, against its bound. Octants
+    /// are searched nearest first (up to rounding, `octants_nearest_first`;
+    /// each tested against the bound when its turn comes), or from
     /// `BEST_FIRST_MIN_K` answers on all pending nodes nearest first (a
     /// per-thread frontier heap). The filter is checked at each
     /// candidate that could enter. No allocation once `out` holds `k` entries.
@@ -171,7 +172,8 @@ impl<T> LinearOctree<T> {
     /// surely beyond the bound (no branch per item: which items pass is
     /// unpredictable, and a mispredicted branch per passer cost ~16 a
     /// query, callgrind W7 points k = 10), then the exact distances of
-    /// those, and then their offers, each tested again against the bound
+    /// those, and then their offers (after the seed block, below), each
+    /// tested again against the bound
     /// its predecessors may have lowered (`KBest::offer_unsynced`; W7 points
     /// k = 10: median 2.27 -> 2.18 µs a query on the probe `knn_leaf`
     /// against a distance and an offer in turn, 22 alternations). A leaf
@@ -200,7 +202,7 @@ impl<T> LinearOctree<T> {
         let mut m = 0;
         // How many of the passers lead as the seed of an empty set.
         let mut taken = 0;
-        // The passers' distances, and whether they are in yet.
+        // The passers' distances, and whether they are computed yet.
         let mut dist = [0.0f32; SEED_MAX];
         let mut measured = false;
         if best.is_empty() && filter.is_none() {
@@ -209,8 +211,9 @@ impl<T> LinearOctree<T> {
             for (d, it) in s2.iter_mut().zip(items) {
                 *d = overlap::point_point_distance_sq(q.point, it.sphere.center);
             }
-            // The k it bounds by go first, nearest first, so that each
-            // enters at the end of the set, then the others that pass.
+            // The k it bounds by go first, nearest first, so that they enter
+            // as one block, mostly without a sort, then the others that
+            // pass.
             // Against the leaf's order: 89 -> 77 mispredicts a query,
             // 12.4k -> 12.6k instructions (callgrind); probe median 2.12
             // -> 2.03 µs a query, faster in 17 of 20 alternations (W7
@@ -271,9 +274,11 @@ impl<T> LinearOctree<T> {
                 m += !metric.excluded(d, &it.sphere, best) as usize;
             }
         }
-        // The few that pass compute their squared distance again (cheaper
-        // than keeping every item's in `f64`, measured before the `f32`
-        // pre-test: a `memset` call per leaf and more mispredicts), and
+        // Outside the seed leaf (which kept every item's squared distance
+        // for its selection) the few that pass compute their squared
+        // distance again (cheaper than keeping every item's in `f64`,
+        // measured before the `f32` pre-test: a `memset` call per leaf and
+        // more mispredicts), and
         // their distances all before any is offered: no distance then waits
         // for the offer before it (each offer lowers the bound the next
         // test reads, and mispredicts where it inserts), so their square

@@ -740,3 +740,100 @@ fn sweeps_over_leaves_of_every_size_match_brute_force() {
         }
     }
 }
+
+/// The depth-first kNN's first descent (straight into the nearest octant
+/// while nothing is held) against brute force where that descent finds
+/// nothing it may keep: a leaf of duplicates next to the query, stored out of
+/// handle order (removals move the last item into the gap), beside a second
+/// cluster in another octant, queried with a limit just below the
+/// duplicates' distance, with a filter that rejects them, and with neither;
+/// k = 1, 2, 5, 10 and 40, both metrics. The same ids and distances, bit for bit.
+#[test]
+fn nearest_when_the_first_descent_keeps_nothing() {
+    use crate::broad::{BruteForce, Filter, Metric, Nearest, Neighbor};
+    let near = vec3(10.25, 20.5, 30.75);
+    let far = vec3(50.5, 44.25, 12.125);
+    let mut rng = Pcg64::seed_from_u64(77);
+    for radius in [0.0f32, 0.25] {
+        let mut t = LinearOctree::with_config(cfg(32, 8, 4)).unwrap();
+        let mut brute = BruteForce::new();
+        // (octree handle, brute handle) per id.
+        let mut live: Vec<(Handle, Handle, u32)> = Vec::new();
+        let mut next = 0u32;
+        let mut add = |t: &mut LinearOctree<u32>, brute: &mut BruteForce<u32>, c: Vec3, g: u32| {
+            let (s, f) = (Sphere::new(c, radius), Filter::new(g, u32::MAX));
+            let id = next;
+            next += 1;
+            (
+                t.insert_with_filter(s, f, id).unwrap(),
+                brute.insert_with_filter(s, f, id).unwrap(),
+                id,
+            )
+        };
+        for _ in 0..24 {
+            live.push(add(&mut t, &mut brute, near, 1));
+        }
+        for _ in 0..40 {
+            let jitter = vec3(rng.gen(), rng.gen(), rng.gen()) * 2.0;
+            live.push(add(&mut t, &mut brute, far + jitter, 2));
+        }
+        // Out of handle order: remove some duplicates and add them back.
+        for _ in 0..10 {
+            // One of the duplicates (ids of the far cluster are 24..64).
+            let mut i = rng.gen_range(0..live.len());
+            while (24..64).contains(&live[i].2) {
+                i = rng.gen_range(0..live.len());
+            }
+            let (a, b, _) = live.swap_remove(i);
+            t.remove(a).unwrap();
+            brute.remove(b).unwrap();
+            live.push(add(&mut t, &mut brute, near, 1));
+        }
+        t.validate().unwrap();
+        let id_of = |v: &[Neighbor], octree: bool| -> Vec<(u32, u32)> {
+            v.iter()
+                .map(|n| {
+                    let e = live
+                        .iter()
+                        .find(|e| {
+                            if octree {
+                                e.0 == n.handle
+                            } else {
+                                e.1 == n.handle
+                            }
+                        })
+                        .unwrap();
+                    (e.2, n.distance.to_bits())
+                })
+                .collect()
+        };
+        let q = near + vec3(0.5, 0.0, 0.0);
+        for metric in [Metric::Surface, Metric::Center] {
+            let dup = metric.distance(q, &Sphere::new(near, radius));
+            let below = f32::from_bits(dup.to_bits() - 1);
+            for k in [1, 2, 5, 10, 40] {
+                for (limit, filter) in [
+                    (f32::INFINITY, None),
+                    (below, None),
+                    (f32::INFINITY, Some(Filter::new(u32::MAX, 2))),
+                    (below, Some(Filter::new(u32::MAX, 1))),
+                ] {
+                    let n = Nearest::new(q, k).metric(metric).within(limit);
+                    let (mut got, mut want) = (Vec::new(), Vec::new());
+                    t.nearest_into(&n, filter, &mut got).unwrap();
+                    brute.nearest_into(&n, filter, &mut want).unwrap();
+                    assert_eq!(
+                        id_of(&got, true),
+                        id_of(&want, false),
+                        "r {radius} {metric:?} k {k} limit {limit} {filter:?}"
+                    );
+                    // The cases are not vacuous: the far cluster answers
+                    // when the duplicates are filtered out.
+                    if filter.is_some_and(|f| f.mask == 2) {
+                        assert_eq!(got.len(), k.min(40));
+                    }
+                }
+            }
+        }
+    }
+}

@@ -34,6 +34,7 @@ pub mod geom;
 mod handle;
 pub mod io;
 pub mod narrow;
+mod prefetch;
 pub mod world;
 
 pub use error::{Error, FileLocation, IoError, Result};

@@ -7,6 +7,7 @@ use super::LinearOctree;
 use crate::broad::filter::Admit;
 use crate::broad::Selection;
 use crate::geom::{Frustum, Relation, Sphere};
+use crate::prefetch::prefetch;
 use crate::Handle;
 use std::ops::ControlFlow;
 
@@ -101,6 +102,14 @@ impl<T> LinearOctree<T> {
                         }
                     }
                 } else {
+                    // The children the query reaches, listed first and
+                    // their nodes prefetched, so that their cache misses
+                    // overlap; each next child's first items are prefetched
+                    // while the one before is searched. W4 (`w4 --only
+                    // LinearOctree`, four alternations): sphere and box
+                    // queries ~5% faster; W8 all hits ~5%.
+                    let mut reached = [(0u32, [0u32; 3]); 8];
+                    let mut m = 0;
                     for (k, &ch) in n.children.iter().enumerate() {
                         if ch == NONE {
                             continue;
@@ -113,6 +122,18 @@ impl<T> LinearOctree<T> {
                         let outer = self.loose_of(cc, d + 1, n.max_extent);
                         if q.classify_box(&outer, mask).0 == Relation::Outside {
                             continue;
+                        }
+                        let node = &self.nodes[ch];
+                        prefetch(&node.items);
+                        prefetch(&node.children);
+                        reached[m] = (ch, cc);
+                        m += 1;
+                    }
+                    for (j, &(ch, cc)) in reached[..m].iter().enumerate() {
+                        if let Some(&(next, _)) = reached[..m].get(j + 1) {
+                            if let Some(it) = self.nodes[next].items.first() {
+                                prefetch(it);
+                            }
                         }
                         self.visit_node(ch, cc, d + 1, mask, q, admit, f)?;
                     }

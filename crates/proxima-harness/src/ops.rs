@@ -256,7 +256,7 @@ impl Named {
 pub fn build(b: &mut Bytes) -> Vec<Named> {
     let mut out: Vec<Named> = vec![Named::new("brute", BruteForce::<u64>::new())];
     // Mostly a sane world; sometimes decoded (possibly invalid) parameters.
-    let sane = b.u8() % 4 != 0;
+    let sane = !b.u8().is_multiple_of(4);
     let world = if sane {
         Aabb::new(Vec3::splat(-16.0), Vec3::splat(16.0))
     } else {
@@ -588,7 +588,7 @@ pub fn run(data: &[u8]) {
             7 => {
                 // A stale handle (removed or cleared) or a foreign one (another
                 // index's handle for a live object): every call must refuse it.
-                let handles: Vec<Handle> = if b.u8() % 2 == 0 && !dead.is_empty() {
+                let handles: Vec<Handle> = if b.u8().is_multiple_of(2) && !dead.is_empty() {
                     dead[b.u8() as usize % dead.len()].clone()
                 } else if !objs.is_empty() {
                     let mut h = objs[b.u8() as usize % objs.len()].handles.clone();
@@ -690,7 +690,7 @@ pub fn run(data: &[u8]) {
             13 => same("pairs", &idx, |i| i.pairs()),
             14 => {
                 // Remove everything, then clear: memory must return to its empty value.
-                if b.u8() % 2 == 0 {
+                if b.u8().is_multiple_of(2) {
                     for o in objs.drain(..) {
                         for (i, &h) in idx.iter_mut().zip(&o.handles) {
                             assert_eq!(i.remove(h), Ok(o.id.into()));

@@ -215,7 +215,7 @@ impl<'t> BruteWorld<'t> {
             for t in &self.local[o.mesh as usize] {
                 if let Some(h) = ray_triangle(&local, &t.tri) {
                     let key = (h.t, id, t.id);
-                    if best.map_or(true, |b| key < b) {
+                    if best.is_none_or(|b| key < b) {
                         best = Some(key);
                     }
                 }

@@ -150,7 +150,7 @@ fn apply<BV: BoundingVolume>(
             let mut best: Option<(f32, u64, u32)> = None;
             for h in world.ray_hits(&ray, Filter::ALL)? {
                 let key = (h.t, *world.get(h.object)?, h.triangle);
-                if best.map_or(true, |b| key < b) {
+                if best.is_none_or(|b| key < b) {
                     best = Some(key);
                 }
             }

@@ -155,7 +155,7 @@ impl<T> Walk<T> for BruteForce<T> {
     fn knn_into(&self, q: &Nearest, filter: Option<Filter>, out: &mut Vec<Neighbor>) {
         out.clear();
         for (h, (s, of, _)) in self.items.iter() {
-            if filter.map_or(true, |f| f.interacts(*of)) {
+            if filter.is_none_or(|f| f.interacts(*of)) {
                 let distance = q.metric.distance(q.point, s);
                 if distance <= q.max_distance {
                     out.push(Neighbor {

@@ -652,7 +652,7 @@ pub(crate) fn expanding<T, I: Walk<T> + ?Sized>(
     if q.k == 0 || n == 0 {
         return;
     }
-    let keep = |h: Handle| filter.map_or(true, |f| f.interacts(index.filter_of(h)));
+    let keep = |h: Handle| filter.is_none_or(|f| f.interacts(index.filter_of(h)));
     let mut r = FIRST_RADIUS.min(q.max_distance);
     loop {
         if r > SCAN_RADIUS {

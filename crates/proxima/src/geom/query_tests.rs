@@ -823,7 +823,7 @@ fn entry_box(rng: &mut Pcg64, o: Vec3, d: Vec3, k: usize) -> Aabb {
             _ => {}
         }
     }
-    if k % 5 == 0 {
+    if k.is_multiple_of(5) {
         let p = o + d * coarse(rng).abs();
         (lo, hi) = (p, p + cv(rng).abs());
     }

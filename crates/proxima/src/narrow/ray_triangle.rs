@@ -51,9 +51,7 @@ impl Hit {
     /// its answer never depends on the order in which triangles are tested.
     #[inline(always)]
     pub(crate) fn precedes(&self, triangle: u32, best: &Option<TriangleHit>) -> bool {
-        best.map_or(true, |b| {
-            self.t < b.t || (self.t == b.t && triangle < b.triangle)
-        })
+        best.is_none_or(|b| self.t < b.t || (self.t == b.t && triangle < b.triangle))
     }
 }
 

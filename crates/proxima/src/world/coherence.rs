@@ -123,7 +123,7 @@ impl<T, BV: BoundingVolume> World<T, BV> {
     /// Whether the object changed since the query of epoch `last`.
     #[inline]
     fn changed(o: &Object<T, BV>, last: Option<u64>) -> bool {
-        last.map_or(true, |e| o.stamp > e)
+        last.is_none_or(|e| o.stamp > e)
     }
 
     /// The plan of a `contacts` query in `mode` (the broad phase is built).

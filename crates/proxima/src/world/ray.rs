@@ -51,7 +51,7 @@ impl<T, BV: BoundingVolume> World<T, BV> {
             }
             let (h, o) = self.objects.get_by_index(slot).expect("a live slot");
             if let Some(hit) = object_hit(h, o, ray)? {
-                if best.map_or(true, |b| hit.key() < b.key()) {
+                if best.is_none_or(|b| hit.key() < b.key()) {
                     best = Some(hit);
                 }
             }

@@ -25,7 +25,7 @@ fn brute(m: &TriMesh, ray: &Ray) -> Option<(u32, f32)> {
     let mut best: Option<(u32, f32)> = None;
     for i in 0..m.len() {
         if let Some(h) = ray_triangle(ray, &m.triangle(i)) {
-            if best.map_or(true, |(_, t)| h.t < t) {
+            if best.is_none_or(|(_, t)| h.t < t) {
                 best = Some((i as u32, h.t));
             }
         }

@@ -171,7 +171,7 @@ fn rays_on_bunny_match_brute_force() {
         let mut want: Option<(u32, f32)> = None;
         for i in 0..bunny.len() {
             if let Some(h) = proxima::narrow::ray_triangle(&ray, &bunny.triangle(i)) {
-                if want.map_or(true, |(_, t)| h.t < t) {
+                if want.is_none_or(|(_, t)| h.t < t) {
                     want = Some((i as u32, h.t));
                 }
             }

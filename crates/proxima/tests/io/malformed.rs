@@ -252,7 +252,7 @@ fn ply_huge_counts_of_empty_rows_fail_fast() {
     assert!(parse("t.ply", head.as_bytes(), Format::Ply).is_err());
     let head = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement other 4000000000\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n";
     let mut data = head.as_bytes().to_vec();
-    data.extend(std::iter::repeat(0u8).take(36));
+    data.extend(std::iter::repeat_n(0u8, 36));
     // Either answer is fine; what matters is that it comes back (no 4e9-row loop).
     let _ = parse("t.ply", &data, Format::Ply);
 }

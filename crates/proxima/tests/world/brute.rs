@@ -121,7 +121,7 @@ impl BruteWorld {
                     let mut best: Option<(f32, u32)> = None;
                     for k in 0..m.triangles.len() {
                         if let Some(hit) = ray_triangle(&local, &m.triangle(k)) {
-                            if best.map_or(true, |b| (hit.t, k as u32) < b) {
+                            if best.is_none_or(|b| (hit.t, k as u32) < b) {
                                 best = Some((hit.t, k as u32));
                             }
                         }

@@ -54,7 +54,7 @@ impl<T, S: Store> CellGrid<T, S> {
             let Some(distance) = q.metric.distance_within(q.point, s, best) else {
                 return;
             };
-            if filter.map_or(true, |f| f.interacts(self.filters[slot as usize])) {
+            if filter.is_none_or(|f| f.interacts(self.filters[slot as usize])) {
                 best.offer(Neighbor {
                     handle: self.handle(slot),
                     distance,

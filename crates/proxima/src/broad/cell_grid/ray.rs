@@ -406,7 +406,7 @@ impl<T, S: Store> CellGrid<T, S> {
     /// the walk, stopping once a contact precedes the strip just finished.
     pub fn first_hit<C: Cast>(&self, cast: &C, filter: Option<Filter>) -> Option<RayHit> {
         let mut best: Option<RayHit> = None;
-        let admits = |slot: u32| filter.map_or(true, |f| f.interacts(self.filters[slot as usize]));
+        let admits = |slot: u32| filter.is_none_or(|f| f.interacts(self.filters[slot as usize]));
         let test = cast.test();
         for &slot in &self.oversized {
             if let Some(t) = test.contact(&self.spheres[slot as usize]) {

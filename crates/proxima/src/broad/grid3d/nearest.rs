@@ -38,7 +38,7 @@ impl<T> UniformGrid3d<T> {
             let Some(distance) = q.metric.distance_within(q.point, s, best) else {
                 return;
             };
-            if filter.map_or(true, |f| f.interacts(self.filters[slot as usize])) {
+            if filter.is_none_or(|f| f.interacts(self.filters[slot as usize])) {
                 best.offer(Neighbor {
                     handle: self.resolve(slot).0,
                     distance,

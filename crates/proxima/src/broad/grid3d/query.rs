@@ -214,7 +214,7 @@ impl<T> UniformGrid3d<T> {
     pub(super) fn walkable<C: Cast>(&self, cast: &C) -> bool {
         // Nothing gridded: the walk returns at once.
         self.extent_magnitude()
-            .map_or(true, |m| cast.walk_fits(m + self.geom.cell))
+            .is_none_or(|m| cast.walk_fits(m + self.geom.cell))
     }
 
     /// Reports the gridded objects a ray or a sphere sweep touches.
@@ -275,7 +275,7 @@ impl<T> UniformGrid3d<T> {
         let offer = |best: &mut Option<RayHit>, slot: u32| {
             let s = &self.spheres[slot as usize];
             if let Some(t) = test.contact(s) {
-                if filter.map_or(true, |f| f.interacts(self.filters[slot as usize])) {
+                if filter.is_none_or(|f| f.interacts(self.filters[slot as usize])) {
                     RayHit::offer(best, t, self.resolve(slot).0);
                 }
             }

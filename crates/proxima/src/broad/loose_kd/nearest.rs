@@ -48,7 +48,7 @@ impl<T> LooseKdTree<T> {
             for (p, s) in node.range().zip(&self.store.sphere[node.range()]) {
                 if let Some(distance) = q.metric.distance_within(q.point, s, &best) {
                     let (handle, of, _) = self.store.full(p);
-                    if filter.map_or(true, |f| f.interacts(of)) {
+                    if filter.is_none_or(|f| f.interacts(of)) {
                         best.offer(Neighbor { handle, distance });
                     }
                 }

@@ -155,7 +155,7 @@ impl LocationCode {
 
     /// A code from its raw bits, if they are well formed (a sentinel at bit `3d`).
     pub fn from_raw(raw: u64) -> Option<LocationCode> {
-        if raw == 0 || (63 - raw.leading_zeros()) % 3 != 0 {
+        if raw == 0 || !(63 - raw.leading_zeros()).is_multiple_of(3) {
             None
         } else {
             Some(LocationCode(raw))

@@ -321,7 +321,7 @@ impl<T> LinearOctree<T> {
         for (&distance, &i) in dist[taken..].iter().zip(&pass[taken..m]) {
             let it = &items[i as usize];
             if distance <= best.bound()
-                && filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter))
+                && filter.is_none_or(|f| f.interacts(self.obj(it.handle).filter))
             {
                 best.offer_unsynced(Neighbor {
                     handle: it.handle,
@@ -357,7 +357,7 @@ impl<T> LinearOctree<T> {
         let Some(distance) = metric.distance_within_given_sq(q.point, &it.sphere, s2, best) else {
             return;
         };
-        if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
+        if filter.is_none_or(|f| f.interacts(self.obj(it.handle).filter)) {
             best.offer(Neighbor {
                 handle: it.handle,
                 distance,

@@ -70,7 +70,7 @@ impl<T> LinearOctree<T> {
         if n.leaf {
             let offer = |t: Option<f32>, it: &Item, best: &mut Option<RayHit>| {
                 if let Some(t) = t {
-                    if filter.map_or(true, |f| f.interacts(self.obj(it.handle).filter)) {
+                    if filter.is_none_or(|f| f.interacts(self.obj(it.handle).filter)) {
                         RayHit::offer(best, t, it.handle);
                     }
                 }

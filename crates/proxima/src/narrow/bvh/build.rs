@@ -180,7 +180,7 @@ fn sah_split(mesh: &TriMesh, centroids: &[Vec3], order: &mut [u32], cb: &Aabb) -
                 continue;
             }
             let cost = area(&acc) * cnt as f32 + right_area[i + 1] * rc as f32;
-            if best.map_or(true, |b| cost < b.0) {
+            if best.is_none_or(|b| cost < b.0) {
                 best = Some((cost, axis, i + 1));
             }
         }

@@ -63,7 +63,7 @@ mod tests {
             x = x.wrapping_mul(1_103_515_245).wrapping_add(12_345);
             // Phases that grow (up to ~100 deep) and shrink.
             let grow = (step / 500) % 2 == 0;
-            if (x >> 16) % 4 != 0 && grow || (x >> 16) % 4 == 0 && !grow {
+            if !(x >> 16).is_multiple_of(4) && grow || (x >> 16).is_multiple_of(4) && !grow {
                 let item = (step, step as f32 * 0.5);
                 s.push(item);
                 v.push(item);

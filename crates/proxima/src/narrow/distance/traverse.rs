@@ -121,7 +121,7 @@ impl Frontier {
             return None;
         }
         let first = match order {
-            Order::BestFirst => self.heap.peek().map_or(true, |&top| near.0 <= unkey(top).0),
+            Order::BestFirst => self.heap.peek().is_none_or(|&top| near.0 <= unkey(top).0),
             Order::DepthFirst => true,
         };
         if first {

@@ -140,13 +140,25 @@ impl<T> LinearOctree<T> {
             if best.exceeds_sq(p.dist_sq) {
                 break;
             }
-            // The next node's first items on their way while this one is
-            // searched (its node was prefetched when it was pushed, below).
-            // Without these two prefetches the loads of a popped node and of
-            // its leaf's first item took ~60% of the search's samples at 1M
-            // (`perf`, W7 spheres k = 100); with them, 31 -> 25 µs a query.
+            // The next node's items (a leaf's, up to 32 of them: one line
+            // per two) and the first items of the two after it in the
+            // heap's layout (`BinaryHeap::iter`'s order: the top's children
+            // there, likely popped soon; only a hint either way) on their
+            // way while this one is searched; their nodes were prefetched
+            // when they were pushed, below. Without these prefetches the
+            // loads of a popped node and of its leaf's first item took ~60%
+            // of the search's samples at 1M (`perf`, W7 spheres k = 100):
+            // with them, ~31 -> ~24 µs a query; of which the two after it
+            // and the whole leaf (instead of its first four lines) ~3%
+            // (seven alternations, 0.85 -> 0.80 of rstar's time at the
+            // median).
             if let Some(next) = heap.peek() {
-                for it in self.nodes[next.node].items.iter().step_by(2).take(4) {
+                for it in self.nodes[next.node].items.iter().step_by(2).take(16) {
+                    prefetch(it);
+                }
+            }
+            for after in heap.iter().skip(1).take(2) {
+                if let Some(it) = self.nodes[after.node].items.first() {
                     prefetch(it);
                 }
             }

@@ -155,10 +155,9 @@ impl<T> LinearOctree<T> {
             // when they were pushed, below. Without these prefetches the
             // loads of a popped node and of its leaf's first item took ~60%
             // of the search's samples at 1M (`perf`, W7 spheres k = 100):
-            // with them, ~31 -> ~24 µs a query; of which the two after it
-            // and the whole leaf (instead of its first four lines) ~3%
-            // (seven alternations, 0.85 -> 0.80 of rstar's time at the
-            // median).
+            // with them, 29.6-31.1 -> 22.3-22.6 µs a query (six
+            // alternations), 0.78-0.81 of rstar's time; with the next
+            // leaf's first four lines alone it was ~0.85.
             if let Some(next) = heap.peek() {
                 for it in self.nodes[next.node].items.iter().step_by(2).take(16) {
                     prefetch(it);
@@ -466,8 +465,8 @@ impl<T> LinearOctree<T> {
             // as the scan reaches it, where the leaves are unlikely to be
             // cached already (the first descent's leaf is the one nothing
             // prefetched before). W7 spheres 1M (three alternations):
-            // k = 10 0.79-0.84 -> 0.67-0.73 of rstar's time, k = 1 0.55 ->
-            // 0.48-0.50. At 100k it gained nothing and cost ~0.4k
+            // k = 10 0.80-0.85 -> 0.72-0.78 of rstar's time, k = 1 0.49-0.56
+            // -> 0.49-0.53. At 100k it gained nothing and cost ~0.4k
             // instructions and ~13 mispredicts a k = 10 query (callgrind;
             // the loop's exit), hence the size test.
             if self.objects.len() >= PREFETCH_LEAF_MIN_OBJECTS {
@@ -481,8 +480,8 @@ impl<T> LinearOctree<T> {
         let (dist, mut mask, near) = self.near_children(n, c, d, q, best);
         if best.is_empty() && mask >> near & 1 == 1 {
             // The first descent, while nothing bounds the search: straight
-            // into the nearest octant, and only then order, touch and visit
-            // the others, against the bound its leaf set. Ordered and
+            // into the nearest octant, and only then order, prefetch and
+            // visit the others, against the bound its leaf set. Ordered and
             // touched now, all eight children would pass the infinite
             // bound, on every level down: 37 children ordered and touched
             // a query, 12 of them visited (callgrind, W7 points k = 10);

@@ -9,7 +9,6 @@ use super::LinearOctree;
 use crate::broad::nearest::{KBest, Metric, Nearest, Neighbor, LINEAR_MAX_K, SEED_MAX};
 use crate::broad::Filter;
 use crate::geom::{overlap, Sphere};
-use crate::prefetch::prefetch;
 use glam::Vec4;
 use std::cell::RefCell;
 use std::cmp::Ordering;
@@ -159,14 +158,10 @@ impl<T> LinearOctree<T> {
             // alternations), 0.78-0.81 of rstar's time; with the next
             // leaf's first four lines alone it was ~0.85.
             if let Some(next) = heap.peek() {
-                for it in self.nodes[next.node].items.iter().step_by(2).take(16) {
-                    prefetch(it);
-                }
+                self.nodes[next.node].prefetch_items(16);
             }
             for after in heap.iter().skip(1).take(2) {
-                if let Some(it) = self.nodes[after.node].items.first() {
-                    prefetch(it);
-                }
+                self.nodes[after.node].prefetch_items(1);
             }
             let n = &self.nodes[p.node];
             if filter.is_some_and(|f| !f.may_interact(n.groups, n.masks)) {
@@ -186,9 +181,7 @@ impl<T> LinearOctree<T> {
             while mask != 0 {
                 let k = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                let ch = &self.nodes[n.children[k]];
-                prefetch(&ch.items);
-                prefetch(&ch.children);
+                self.prefetch_node(n.children[k]);
                 heap.push(Pending {
                     dist_sq: dist[k],
                     node: n.children[k],
@@ -470,9 +463,7 @@ impl<T> LinearOctree<T> {
             // instructions and ~13 mispredicts a k = 10 query (callgrind;
             // the loop's exit), hence the size test.
             if self.objects.len() >= PREFETCH_LEAF_MIN_OBJECTS {
-                for it in n.items.iter().step_by(2).take(16) {
-                    prefetch(it);
-                }
+                n.prefetch_items(16);
             }
             self.offer_leaf(n, q, filter, best);
             return;
@@ -518,15 +509,11 @@ impl<T> LinearOctree<T> {
         // behind them: `knn_leaf 100000 10 50000 32` median 0.94× the time
         // (eight alternations, faster in six), k = 1 unchanged.
         for &o in &order[..m] {
-            let ch = &self.nodes[n.children[o as usize]];
-            prefetch(&ch.items);
-            prefetch(&ch.children);
+            self.prefetch_node(n.children[o as usize]);
         }
         for (j, &o) in order[..m].iter().enumerate() {
             if let Some(&next) = order[..m].get(j + 1) {
-                if let Some(it) = self.nodes[n.children[next as usize]].items.first() {
-                    prefetch(it);
-                }
+                self.nodes[n.children[next as usize]].prefetch_items(1);
             }
             let o = o as usize;
             // The bound may have fallen since the mask was made. The order is

@@ -7,7 +7,6 @@ use super::LinearOctree;
 use crate::broad::filter::Admit;
 use crate::broad::Selection;
 use crate::geom::{Frustum, Relation, Sphere};
-use crate::prefetch::prefetch;
 use crate::Handle;
 use std::ops::ControlFlow;
 
@@ -123,17 +122,13 @@ impl<T> LinearOctree<T> {
                         if q.classify_box(&outer, mask).0 == Relation::Outside {
                             continue;
                         }
-                        let node = &self.nodes[ch];
-                        prefetch(&node.items);
-                        prefetch(&node.children);
+                        self.prefetch_node(ch);
                         reached[m] = (ch, cc);
                         m += 1;
                     }
                     for (j, &(ch, cc)) in reached[..m].iter().enumerate() {
                         if let Some(&(next, _)) = reached[..m].get(j + 1) {
-                            if let Some(it) = self.nodes[next].items.first() {
-                                prefetch(it);
-                            }
+                            self.nodes[next].prefetch_items(1);
                         }
                         self.visit_node(ch, cc, d + 1, mask, q, admit, f)?;
                     }

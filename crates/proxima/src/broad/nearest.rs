@@ -325,6 +325,17 @@ impl<'a> KBest<'a> {
         self.mid_sq_f32
     }
 
+    /// The bound's midpoint rounded up to `f32`, for the spheres' four-lane
+    /// pre-test ([`overlap::spheres_beyond_f32_4`]): a sphere it sets a bit
+    /// for surely cannot enter in [`Metric::Surface`] ([`KBest::exceeds`]
+    /// holds for it). Computed on each call (a few instructions), not kept
+    /// beside the others: [`KBest::sync`] runs after every offer in some
+    /// searches. O(1).
+    #[inline]
+    pub(crate) fn midpoint_up_f32(&self) -> f32 {
+        overlap::midpoint_up_f32(self.mid)
+    }
+
     fn set_bound(&mut self, bound: f32) {
         self.bound = bound;
         self.sync();

@@ -934,6 +934,49 @@ pub(crate) fn point_point_distance_sq_f32_4(p: Vec3, s: [&Sphere; 4]) -> Vec4 {
     x * x + y * y + z * z
 }
 
+/// The four-lane `f32` pre-test of [`distance_exceeds`] for spheres (the
+/// surface metric): bit `j` set when sphere `s[j]` is surely farther than the
+/// bound whose midpoint ([`distance_midpoint`]) rounded up to `f32` is `m`
+/// ([`midpoint_up_f32`]). A lane's `|c - p|²` (as
+/// [`point_point_distance_sq_f32_4`]) is compared with `(m + r)²` grown by
+/// `2^-16` relative and by `f32::MIN_POSITIVE`, all in `f32`.
+///
+/// Why a set bit implies `distance_exceeds(s2, r, d)`: `m + r`, its square
+/// and the growth each round once (down by at most `u = 2^-24` relative,
+/// or by an underflow far below `f32::MIN_POSITIVE`), so the lane's
+/// threshold is at least `(m₆₄ + r)²·(1 + 2^-17)`; the lane's distance is
+/// at most `(1 + u)^5` times the exact `D = |c - p|²` (plus an underflow
+/// under `2^-148`, see `point_point_distance_sq_f32`), so a lane above its
+/// threshold has `D > (m₆₄ + r)²·(1 + 2^-18)`, and the `f64` `s2 ≥ D·(1 -
+/// 6·2^-53)` is above `exceeds_threshold`'s `(m₆₄ + r)²·(1 + 1e-12)`
+/// (rounded three times in `f64`). An infinite `m` sets no bit. So the
+/// pre-test only ever keeps too many. O(1).
+#[inline(always)]
+pub(crate) fn spheres_beyond_f32_4(p: Vec3, s: [&Sphere; 4], m: f32) -> u32 {
+    let [cx, cy, cz, r] = sphere_lanes(s);
+    let (x, y, z) = (
+        cx - Vec4::splat(p.x),
+        cy - Vec4::splat(p.y),
+        cz - Vec4::splat(p.z),
+    );
+    let d = x * x + y * y + z * z;
+    let a = Vec4::splat(m) + r;
+    let t = a * a * Vec4::splat(1.0 + 1.0 / 65_536.0) + Vec4::splat(f32::MIN_POSITIVE);
+    d.cmpgt(t).bitmask()
+}
+
+/// The `f64` midpoint `m` of [`distance_midpoint`] rounded up to `f32` (`∞`
+/// past `f32::MAX`): the `m` of [`spheres_beyond_f32_4`]. O(1).
+#[inline]
+pub(crate) fn midpoint_up_f32(m: f64) -> f32 {
+    let f = m as f32;
+    if (f as f64) < m {
+        f.next_up()
+    } else {
+        f
+    }
+}
+
 /// Four spheres as SIMD lanes: their `x`, `y`, `z` and radii, one vector
 /// each (the rows `(x, y, z, r)` transposed, a few shuffles). O(1).
 #[inline(always)]
@@ -1606,6 +1649,83 @@ mod tests {
         assert!(kept_finite > 100_000, "{kept_finite}");
         assert_eq!(sq_threshold_f32(f64::INFINITY), f32::INFINITY);
         assert_eq!(sq_threshold_f32(1e300), f32::INFINITY);
+    }
+
+    /// The spheres' four-lane pre-test never rules out a sphere whose
+    /// correctly rounded surface distance is at most the bound (nor one
+    /// `distance_exceeds` keeps), at every scale and at the rounding
+    /// boundary itself (the bound set to the sphere's own distance and the
+    /// `f32`s around it); and it does rule out the spheres well beyond it,
+    /// so it prunes.
+    #[test]
+    fn spheres_f32_pre_test_keeps_every_sphere_within_the_bound() {
+        let mut st = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            st ^= st << 13;
+            st ^= st >> 7;
+            st ^= st << 17;
+            st
+        };
+        let unit = |b: u64| (b >> 40) as f32 / (1u64 << 24) as f32 - 0.5;
+        let (mut pruned, mut far) = (0, 0);
+        for k in 0..100_000 {
+            let scale = [1e-40f32, 1e-20, 1e-3, 1.0, 1e3, 1e18, 1e36][k % 7];
+            let v = |b: u64| Vec3::new(unit(b), unit(b << 8), unit(b << 16)) * scale;
+            let p = v(next());
+            let spheres = [0, 1, 2, 3].map(|j| {
+                let c = if j == 3 && k % 3 == 0 { p } else { v(next()) };
+                let r = match j {
+                    0 => 0.0,
+                    1 => unit(next()).abs() * scale,
+                    _ => (unit(next()).abs() * scale * 4.0).min(f32::MAX),
+                };
+                Sphere::new(c, r)
+            });
+            if spheres.iter().any(|s| !s.center.is_finite()) || !p.is_finite() {
+                continue;
+            }
+            // The bound: one lane's own distance, an ulp around it, or a
+            // fraction of it (then the spheres beyond it should go).
+            let lane = (next() % 4) as usize;
+            let own = point_sphere_distance(p, &spheres[lane]);
+            let d = match k % 5 {
+                0 => own,
+                1 => own.next_down().max(0.0),
+                2 => own.next_up(),
+                3 => own * 0.5,
+                _ => f32::INFINITY,
+            };
+            let m = midpoint_up_f32(distance_midpoint(d));
+            let bits = spheres_beyond_f32_4(p, spheres.each_ref(), m);
+            for (j, s) in spheres.iter().enumerate() {
+                let set = bits >> j & 1 == 1;
+                let exact = point_sphere_distance(p, s);
+                let s2 = point_point_distance_sq(p, s.center);
+                if exact <= d || !distance_exceeds(s2, s.radius, d) {
+                    assert!(!set, "{p:?} {s:?} d {d:e}: ruled out at {exact:e}");
+                }
+                // Well beyond, at scales whose squares are normal `f32`s
+                // (below, they underflow and the pre-test keeps them): the
+                // pre-test prunes.
+                let margin = (d as f64 + s.radius as f64) * 1e-3 + 1e-30;
+                if (1e-10..1e30).contains(&scale) && exact as f64 > d as f64 + margin {
+                    far += 1;
+                    pruned += set as u32;
+                }
+            }
+        }
+        assert!(
+            far > 10_000 && pruned == far,
+            "{pruned} of {far} far spheres pruned"
+        );
+        let one = Sphere::new(Vec3::ONE, 1.0);
+        assert_eq!(
+            spheres_beyond_f32_4(Vec3::ZERO, [&one; 4], f32::INFINITY),
+            0
+        );
+        assert_eq!(midpoint_up_f32(f64::INFINITY), f32::INFINITY);
+        assert_eq!(midpoint_up_f32(1e300), f32::INFINITY);
+        assert_eq!(midpoint_up_f32(1.5), 1.5);
     }
 
     #[test]

@@ -263,41 +263,32 @@ impl<T> LinearOctree<T> {
                 *d = metric.distance_given_sq(q.point, &it.sphere, s2[i as usize]);
             }
             measured = true;
-        } else if metric == Metric::Center && !items.is_empty() {
-            // In `f32`: no conversions, and the passers' exact test below
-            // keeps the answer brute force's. Four items at a time, one per
-            // SIMD lane; their passers' positions are written four bytes at
-            // once from a table (`QUAD_PASSERS`). Against one item at a time
+        } else if !items.is_empty() {
+            // In `f32`, four items at a time (`list_passers`): no
+            // conversions, and the passers' exact test below keeps the
+            // answer brute force's. Against one item at a time in `f64`
             // (W7 points k = 10, `knn_leaf 100000 10 2000 32`, callgrind):
             // 12.57k -> 11.89k instructions a query; `knn_leaf 100000 10
             // 50000 32` median 2.24 -> 2.13 µs, faster in 13 of 16
-            // alternations.
-            let t = Vec4::splat(best.sq_threshold_f32());
-            let mut quad = |from: usize, spheres: [&Sphere; 4], live: u32| {
-                let d = overlap::point_point_distance_sq_f32_4(q.point, spheres);
-                let bits = (!d.cmpgt(t).bitmask() & live) as usize;
-                let at = QUAD_PASSERS[bits] + from as u32 * 0x0101_0101;
-                pass[m..m + 4].copy_from_slice(&at.to_le_bytes());
-                m += QUAD_COUNT[bits] as usize;
+            // alternations. Spheres (the surface metric) take a threshold
+            // per lane grown by its radius (`spheres_beyond_f32_4`). One
+            // copy of the loop per metric, not a branch per quad.
+            m = match metric {
+                Metric::Center => {
+                    let t = Vec4::splat(best.sq_threshold_f32());
+                    list_passers(items, &mut pass, |s| {
+                        overlap::point_point_distance_sq_f32_4(q.point, s)
+                            .cmpgt(t)
+                            .bitmask()
+                    })
+                }
+                Metric::Surface => {
+                    let mid = best.midpoint_up_f32();
+                    list_passers(items, &mut pass, |s| {
+                        overlap::spheres_beyond_f32_4(q.point, s, mid)
+                    })
+                }
             };
-            let mut quads = items.chunks_exact(4);
-            let mut from = 0;
-            for c in &mut quads {
-                quad(from, [0, 1, 2, 3].map(|j| &c[j].sphere), 0xF);
-                from += 4;
-            }
-            // The last 0-3 items as one more quad with its other lanes
-            // masked off: no loop whose length varies by leaf (its exit
-            // mispredicted about once a leaf).
-            let last = items.len() - 1;
-            let rest = [0, 1, 2, 3].map(|j| &items[(from + j).min(last)].sphere);
-            quad(from, rest, (1 << quads.remainder().len()) - 1);
-        } else {
-            for (i, it) in items.iter().enumerate() {
-                let d = overlap::point_point_distance_sq(q.point, it.sphere.center);
-                pass[m] = i as u8;
-                m += !metric.excluded(d, &it.sphere, best) as usize;
-            }
         }
         // Outside the seed leaf (which kept every item's squared distance
         // for its selection) the few that pass compute their squared
@@ -551,6 +542,52 @@ const QUAD_PASSERS: [u32; 16] = {
 /// The number of set bits of each mask of four (no `popcnt` in the
 /// baseline x86-64 target).
 const QUAD_COUNT: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
+
+/// Lists in `pass` the indices of the items of a non-empty leaf that
+/// `beyond` (four spheres at a time, a bit per lane surely beyond the
+/// search's bound) does not rule out, and returns how many. The positions
+/// are written four bytes at once from a table (`QUAD_PASSERS`), and the
+/// last 0-3 items go as one more quad with its other lanes masked off: no
+/// branch per item and no loop whose length varies by leaf (its exit
+/// mispredicted about once a leaf). O(items).
+#[inline(always)]
+fn list_passers(
+    items: &[Item],
+    pass: &mut [u8; SEED_MAX + 4],
+    beyond: impl Fn([&Sphere; 4]) -> u32,
+) -> usize {
+    // A function, not a closure: the closure was compiled as a call
+    // (callgrind, W7 points k = 10: +2% instructions a query).
+    #[inline(always)]
+    fn quad(pass: &mut [u8], m: usize, from: usize, beyond: u32, live: u32) -> usize {
+        let bits = (!beyond & live) as usize;
+        let at = QUAD_PASSERS[bits] + from as u32 * 0x0101_0101;
+        pass[m..m + 4].copy_from_slice(&at.to_le_bytes());
+        m + QUAD_COUNT[bits] as usize
+    }
+    let mut m = 0;
+    let mut quads = items.chunks_exact(4);
+    let mut from = 0;
+    for c in &mut quads {
+        m = quad(
+            pass,
+            m,
+            from,
+            beyond([0, 1, 2, 3].map(|j| &c[j].sphere)),
+            0xF,
+        );
+        from += 4;
+    }
+    let last = items.len() - 1;
+    let rest = [0, 1, 2, 3].map(|j| &items[(from + j).min(last)].sphere);
+    quad(
+        pass,
+        m,
+        from,
+        beyond(rest),
+        (1 << quads.remainder().len()) - 1,
+    )
+}
 
 /// The metric to measure leaf `n`'s items in: the query's, or
 /// [`Metric::Center`] when every item's radius is zero (the leaf's largest

@@ -684,7 +684,7 @@ pub(crate) fn expanding<T, I: Walk<T> + ?Sized>(
         }
         out.clear();
         let (mut seen, mut close) = (0usize, 0usize);
-        let reach = Sphere::new(q.point, next_up(r));
+        let reach = Sphere::new(q.point, r.next_up());
         let _ = index.walk(&reach, |h, s, _| {
             seen += 1;
             if keep(h) {
@@ -706,17 +706,6 @@ pub(crate) fn expanding<T, I: Walk<T> + ?Sized>(
         // A limit just above `r` may be reached exactly: the next round ends.
     }
     finish(out, q.k);
-}
-
-/// The next `f32` up (`f32::next_up` needs Rust 1.86; the MSRV is 1.80). For
-/// finite non-negative `x`.
-#[inline]
-fn next_up(x: f32) -> f32 {
-    if x == 0.0 {
-        f32::from_bits(1)
-    } else {
-        f32::from_bits(x.to_bits() + 1)
-    }
 }
 
 /// Whether some distance from `point` to a sphere inside `extent` may round

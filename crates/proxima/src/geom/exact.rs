@@ -226,18 +226,11 @@ pub(crate) fn round_down_f32(x: f64) -> f32 {
     }
 }
 
-/// The next `f32` toward −∞ (`f32::next_down` needs Rust 1.86; the MSRV is 1.80).
+/// The next `f32` toward −∞ (`f32::next_down`: NaN and −∞ stay, ±0 gives
+/// the negative smallest subnormal). The name predates the MSRV that has it.
 #[inline]
 pub(crate) fn f32_down(y: f32) -> f32 {
-    if y.is_nan() || y == f32::NEG_INFINITY {
-        y
-    } else if y == 0.0 {
-        -f32::from_bits(1)
-    } else if y > 0.0 {
-        f32::from_bits(y.to_bits() - 1)
-    } else {
-        f32::from_bits(y.to_bits() + 1)
-    }
+    y.next_down()
 }
 
 #[cfg(test)]

@@ -926,6 +926,14 @@ pub(crate) fn point_point_distance_sq_f32(p: Vec3, c: Vec3) -> f32 {
 #[inline(always)]
 pub(crate) fn point_point_distance_sq_f32_4(p: Vec3, s: [&Sphere; 4]) -> Vec4 {
     let [cx, cy, cz, _] = sphere_lanes(s);
+    distance_sq_lanes(p, [cx, cy, cz])
+}
+
+/// `|c - p|²` in `f32` to the four centres whose `x`, `y`, `z` are the
+/// lanes of `c`: the one body of [`point_point_distance_sq_f32_4`] and
+/// [`spheres_beyond_f32_4`]. O(1).
+#[inline(always)]
+fn distance_sq_lanes(p: Vec3, [cx, cy, cz]: [Vec4; 3]) -> Vec4 {
     let (x, y, z) = (
         cx - Vec4::splat(p.x),
         cy - Vec4::splat(p.y),
@@ -937,44 +945,48 @@ pub(crate) fn point_point_distance_sq_f32_4(p: Vec3, s: [&Sphere; 4]) -> Vec4 {
 /// The four-lane `f32` pre-test of [`distance_exceeds`] for spheres (the
 /// surface metric): bit `j` set when sphere `s[j]` is surely farther than the
 /// bound whose midpoint ([`distance_midpoint`]) rounded up to `f32` is `m`
-/// ([`midpoint_up_f32`]). A lane's `|c - p|²` (as
-/// [`point_point_distance_sq_f32_4`]) is compared with `(m + r)²` grown by
-/// `2^-16` relative and by `f32::MIN_POSITIVE`, all in `f32`.
+/// ([`midpoint_up_f32`]): a lane's `|c - p|²` (as
+/// [`point_point_distance_sq_f32_4`]) above its
+/// [`sphere_sq_thresholds_f32_4`]. O(1).
 ///
-/// Why a set bit implies `distance_exceeds(s2, r, d)`: `m + r`, its square
-/// and the growth each round once (down by at most `u = 2^-24` relative,
-/// or by an underflow far below `f32::MIN_POSITIVE`), so the lane's
-/// threshold is at least `(m₆₄ + r)²·(1 + 2^-17)`; the lane's distance is
-/// at most `(1 + u)^5` times the exact `D = |c - p|²` (plus an underflow
-/// under `2^-148`, see `point_point_distance_sq_f32`), so a lane above its
-/// threshold has `D > (m₆₄ + r)²·(1 + 2^-18)`, and the `f64` `s2 ≥ D·(1 -
-/// 6·2^-53)` is above `exceeds_threshold`'s `(m₆₄ + r)²·(1 + 1e-12)`
-/// (rounded three times in `f64`). An infinite `m` sets no bit. So the
-/// pre-test only ever keeps too many. O(1).
+/// Why a set bit implies `distance_exceeds(s2, r, d)`: write `A = m₆₄ + r`
+/// (`m₆₄` the `f64` midpoint). The threshold is at least `A²·(1 + 2^-17) +
+/// 2^-126` or `∞` (see there). The lane's distance is at most `(1 + u)^5`
+/// times the exact `D = |c - p|²` plus an underflow under `2^-148` (see
+/// `point_point_distance_sq_f32`), so a lane above a finite threshold has
+/// `D > A²·(1 + 2^-18)`, and the `f64` `s2 ≥ D·(1 - 6·2^-53)` is above
+/// `exceeds_threshold`'s `A²·(1 + 1e-12)` (rounded three times in `f64`). A
+/// lane whose distance overflowed to `∞` has `D > f32::MAX·(1 - 4u)`, and a
+/// finite threshold means `A²·(1 + 2^-17) ≤ f32::MAX`: the same conclusion.
+/// An infinite threshold (an infinite `m`, or an overflow) sets no bit. So
+/// the pre-test only ever keeps too many.
 #[inline(always)]
 pub(crate) fn spheres_beyond_f32_4(p: Vec3, s: [&Sphere; 4], m: f32) -> u32 {
     let [cx, cy, cz, r] = sphere_lanes(s);
-    let (x, y, z) = (
-        cx - Vec4::splat(p.x),
-        cy - Vec4::splat(p.y),
-        cz - Vec4::splat(p.z),
-    );
-    let d = x * x + y * y + z * z;
+    let d = distance_sq_lanes(p, [cx, cy, cz]);
+    d.cmpgt(sphere_sq_thresholds_f32_4(m, r)).bitmask()
+}
+
+/// The thresholds of [`spheres_beyond_f32_4`] for radii `r` (non-negative)
+/// and the rounded-up midpoint `m`: `(m + r)²` grown by `2^-16` relative and
+/// by `2·f32::MIN_POSITIVE`, in `f32`. At least `A²·(1 + 2^-17) + 2^-126`
+/// for `A = m₆₄ + r` (`m ≥ m₆₄`) or `∞`: the sum, the square and the
+/// product each round down by at most `u = 2^-24` relative (or underflow
+/// under `2^-149`), and the growth's `(1 + 2^-16)·(1 - u)^5` exceeds `1 +
+/// 2^-17`. The additive term is doubled so that a host which flushes
+/// subnormal results to zero (a square just under `2^-126` becoming 0) still
+/// gets a threshold above `A²`. O(1).
+#[inline(always)]
+pub(crate) fn sphere_sq_thresholds_f32_4(m: f32, r: Vec4) -> Vec4 {
     let a = Vec4::splat(m) + r;
-    let t = a * a * Vec4::splat(1.0 + 1.0 / 65_536.0) + Vec4::splat(f32::MIN_POSITIVE);
-    d.cmpgt(t).bitmask()
+    a * a * Vec4::splat(1.0 + 1.0 / 65_536.0) + Vec4::splat(2.0 * f32::MIN_POSITIVE)
 }
 
 /// The `f64` midpoint `m` of [`distance_midpoint`] rounded up to `f32` (`∞`
 /// past `f32::MAX`): the `m` of [`spheres_beyond_f32_4`]. O(1).
 #[inline]
 pub(crate) fn midpoint_up_f32(m: f64) -> f32 {
-    let f = m as f32;
-    if (f as f64) < m {
-        f.next_up()
-    } else {
-        f
-    }
+    -round_down(-m)
 }
 
 /// Four spheres as SIMD lanes: their `x`, `y`, `z` and radii, one vector
@@ -1655,8 +1667,9 @@ mod tests {
     /// correctly rounded surface distance is at most the bound (nor one
     /// `distance_exceeds` keeps), at every scale and at the rounding
     /// boundary itself (the bound set to the sphere's own distance and the
-    /// `f32`s around it); and it does rule out the spheres well beyond it,
-    /// so it prunes.
+    /// `f32`s around it), with distances and radii that overflow `f32`;
+    /// it does rule out the spheres well beyond it, so it prunes; and its
+    /// thresholds meet their stated lower bound at every scale.
     #[test]
     fn spheres_f32_pre_test_keeps_every_sphere_within_the_bound() {
         let mut st = 0x9E37_79B9_7F4A_7C15u64;
@@ -1669,7 +1682,7 @@ mod tests {
         let unit = |b: u64| (b >> 40) as f32 / (1u64 << 24) as f32 - 0.5;
         let (mut pruned, mut far) = (0, 0);
         for k in 0..100_000 {
-            let scale = [1e-40f32, 1e-20, 1e-3, 1.0, 1e3, 1e18, 1e36][k % 7];
+            let scale = [1e-40f32, 1e-20, 1e-3, 1.0, 1e3, 1e18, 1e20, 1e36][k % 8];
             let v = |b: u64| Vec3::new(unit(b), unit(b << 8), unit(b << 16)) * scale;
             let p = v(next());
             let spheres = [0, 1, 2, 3].map(|j| {
@@ -1677,7 +1690,10 @@ mod tests {
                 let r = match j {
                     0 => 0.0,
                     1 => unit(next()).abs() * scale,
-                    _ => (unit(next()).abs() * scale * 4.0).min(f32::MAX),
+                    // Now and then a radius near `f32::MAX` (its threshold
+                    // overflows).
+                    _ if k % 11 == 0 => f32::MAX * unit(next()).abs(),
+                    _ => unit(next()).abs() * scale * 4.0,
                 };
                 Sphere::new(c, r)
             });
@@ -1705,10 +1721,11 @@ mod tests {
                     assert!(!set, "{p:?} {s:?} d {d:e}: ruled out at {exact:e}");
                 }
                 // Well beyond, at scales whose squares are normal `f32`s
-                // (below, they underflow and the pre-test keeps them): the
-                // pre-test prunes.
+                // (below they underflow, above they overflow, and the
+                // pre-test keeps them): the pre-test prunes.
                 let margin = (d as f64 + s.radius as f64) * 1e-3 + 1e-30;
-                if (1e-10..1e30).contains(&scale) && exact as f64 > d as f64 + margin {
+                let normal = (1e-10..1e19).contains(&scale) && s.radius < 1e19;
+                if normal && exact as f64 > d as f64 + margin {
                     far += 1;
                     pruned += set as u32;
                 }
@@ -1718,6 +1735,31 @@ mod tests {
             far > 10_000 && pruned == far,
             "{pruned} of {far} far spheres pruned"
         );
+        // The thresholds themselves, against their bound in `f64`: at least
+        // `(m + r)²·(1 + 2^-17) + 2^-126`, or `∞`, over every scale of `m`
+        // and `r` (subnormal to overflowing).
+        for k in 0..200_000 {
+            let (b1, b2) = (next(), next());
+            let m = f32::from_bits((b1 as u32) & 0x7F7F_FFFF);
+            let r = Vec4::from_array([0, 16, 32, 48].map(|sh| {
+                let bits = (b2 >> sh) as u32 & 0x7F7F_FFFF;
+                if k % 3 == 0 {
+                    // Subnormal or tiny.
+                    f32::from_bits(bits & 0x00FF_FFFF)
+                } else {
+                    f32::from_bits(bits)
+                }
+            }));
+            let t = sphere_sq_thresholds_f32_4(m, r).to_array();
+            for (t, r) in t.iter().zip(r.to_array()) {
+                let a = m as f64 + r as f64;
+                let low = a * a * (1.0 + 2f64.powi(-17)) + 2f64.powi(-126);
+                assert!(
+                    *t == f32::INFINITY || *t as f64 >= low,
+                    "m {m:e} r {r:e}: {t:e}"
+                );
+            }
+        }
         let one = Sphere::new(Vec3::ONE, 1.0);
         assert_eq!(
             spheres_beyond_f32_4(Vec3::ZERO, [&one; 4], f32::INFINITY),

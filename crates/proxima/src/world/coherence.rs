@@ -154,11 +154,8 @@ impl<T, BV: BoundingVolume> World<T, BV> {
 
     /// Every candidate pair from the broad phase's pair search.
     fn plan_all(&self, last: Option<u64>, mode: ContactMode, plan: &mut Plan) {
-        let index = self.broad.index.as_ref().expect("the broad phase is built");
-        let _ = index.for_each_pair(|_, &sa, _, &sb| {
-            self.consider(sa, sb, last, mode, plan);
-            std::ops::ControlFlow::Continue(())
-        });
+        self.broad
+            .for_each_pair(&mut |sa, sb| self.consider(sa, sb, last, mode, plan));
     }
 
     /// The pairs of the changed objects from sphere queries; the others from

@@ -169,9 +169,10 @@ impl Broad {
 /// [`Broad::visit`] through the index. Not generic, the caller's closure
 /// behind `dyn`: the index walks are compiled once, in this crate, rather
 /// than once per world method, payload type and bounding volume in every
-/// crate that uses a [`World`](super::World) (the world tests' build took
-/// 327 s of CPU, most of it in copies of the grids' walks); it costs an
-/// indirect call per candidate, beside the narrow test each one gets.
+/// crate that uses a [`World`](super::World) (the world tests' crate took
+/// 327 s to build in CI's `cargo test`, most of it in copies of the grids'
+/// walks; 44 s since); it costs an indirect call per candidate, beside the
+/// narrow test each one gets. [`Broad::for_each_pair`] likewise.
 fn visit_index(index: &AnyIndex<u32>, query: &Query, f: &mut dyn FnMut(u32)) -> Result<()> {
     let _ = index.for_each_in(*query, |_, _, &slot| {
         f(slot);

@@ -155,8 +155,10 @@ impl Broad {
     }
 
     /// Calls `f` with the slots of every overlapping pair of objects whose
-    /// filters interact, once each, through the index. Panics if the index
-    /// is not built (the callers build it first).
+    /// filters interact, once each, in no particular order, through the
+    /// index's pair search (its cost). The callback sits behind `dyn` for the
+    /// reason given at [`visit_index`]. Panics if the index is not built (the
+    /// callers build it first).
     pub(crate) fn for_each_pair(&self, f: &mut dyn FnMut(u32, u32)) {
         let index = self.index.as_ref().expect("the broad phase is built");
         let _ = index.for_each_pair(|_, &a, _, &b| {
@@ -171,8 +173,9 @@ impl Broad {
 /// than once per world method, payload type and bounding volume in every
 /// crate that uses a [`World`](super::World) (the world tests' crate took
 /// 327 s to build in CI's `cargo test`, most of it in copies of the grids'
-/// walks; 44 s since); it costs an indirect call per candidate, beside the
-/// narrow test each one gets. [`Broad::for_each_pair`] likewise.
+/// walks; 44 s since: `docs/bench/ci-build-e7d3473.txt`). It costs an
+/// indirect call per candidate, small beside what the world's callers do with
+/// one (callgrind on the world bench scenes: +0.01% instructions).
 fn visit_index(index: &AnyIndex<u32>, query: &Query, f: &mut dyn FnMut(u32)) -> Result<()> {
     let _ = index.for_each_in(*query, |_, _, &slot| {
         f(slot);

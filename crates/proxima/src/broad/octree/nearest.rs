@@ -277,20 +277,22 @@ impl<T> LinearOctree<T> {
             // instructions against an `f64` test per item). One copy of the
             // loop per metric, not a branch per quad.
             m = match metric {
-                Metric::Center => {
-                    let t = Vec4::splat(best.sq_threshold_f32());
-                    list_passers(items, &mut pass, |s| {
-                        overlap::point_point_distance_sq_f32_4(q.point, s)
-                            .cmpgt(t)
-                            .bitmask()
-                    })
-                }
-                Metric::Surface => {
-                    let mid = best.midpoint_up_f32();
-                    list_passers(items, &mut pass, |s| {
-                        overlap::spheres_beyond_f32_4(q.point, s, mid)
-                    })
-                }
+                Metric::Center => list_passers(
+                    items,
+                    &mut pass,
+                    &CentresBeyond {
+                        point: q.point,
+                        t: Vec4::splat(best.sq_threshold_f32()),
+                    },
+                ),
+                Metric::Surface => list_passers(
+                    items,
+                    &mut pass,
+                    &SpheresBeyond {
+                        point: q.point,
+                        mid: best.midpoint_up_f32(),
+                    },
+                ),
             };
         }
         // Outside the seed leaf (which kept every item's squared distance
@@ -546,6 +548,45 @@ const QUAD_PASSERS: [u32; 16] = {
 /// baseline x86-64 target).
 const QUAD_COUNT: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
 
+/// The leaf step's four-lane pre-test: a bit per lane whose sphere surely
+/// cannot enter the search's candidate set. A trait with always-inlined
+/// methods rather than a closure: `list_passers` calls it at two sites, and
+/// the closure was compiled out of line there (callgrind, W7 points
+/// k = 10: a call per leaf, ~35 instructions each).
+trait QuadBeyond {
+    fn beyond(&self, s: [&Sphere; 4]) -> u32;
+}
+
+/// Points (`Metric::Center`, or radius 0): the `f32` squared centre
+/// distance above `t` ([`KBest::sq_threshold_f32`]).
+struct CentresBeyond {
+    point: glam::Vec3,
+    t: Vec4,
+}
+
+impl QuadBeyond for CentresBeyond {
+    #[inline(always)]
+    fn beyond(&self, s: [&Sphere; 4]) -> u32 {
+        overlap::point_point_distance_sq_f32_4(self.point, s)
+            .cmpgt(self.t)
+            .bitmask()
+    }
+}
+
+/// Spheres (`Metric::Surface`): [`overlap::spheres_beyond_f32_4`] at the
+/// bound's midpoint rounded up ([`KBest::midpoint_up_f32`]).
+struct SpheresBeyond {
+    point: glam::Vec3,
+    mid: f32,
+}
+
+impl QuadBeyond for SpheresBeyond {
+    #[inline(always)]
+    fn beyond(&self, s: [&Sphere; 4]) -> u32 {
+        overlap::spheres_beyond_f32_4(self.point, s, self.mid)
+    }
+}
+
 /// Lists in `pass` the indices of the items of a non-empty leaf that
 /// `beyond` (four spheres at a time, a bit per lane surely beyond the
 /// search's bound) does not rule out, and returns how many. The positions
@@ -554,11 +595,7 @@ const QUAD_COUNT: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
 /// branch per item and no loop whose length varies by leaf (its exit
 /// mispredicted about once a leaf). O(items).
 #[inline(always)]
-fn list_passers(
-    items: &[Item],
-    pass: &mut [u8; SEED_MAX + 4],
-    beyond: impl Fn([&Sphere; 4]) -> u32,
-) -> usize {
+fn list_passers(items: &[Item], pass: &mut [u8; SEED_MAX + 4], beyond: &impl QuadBeyond) -> usize {
     // A function, not a closure: the closure was compiled as a call
     // (callgrind, W7 points k = 10: +2.6% instructions a query).
     #[inline(always)]
@@ -577,18 +614,22 @@ fn list_passers(
             pass,
             m,
             from,
-            beyond([0, 1, 2, 3].map(|j| &c[j].sphere)),
+            beyond.beyond([&c[0].sphere, &c[1].sphere, &c[2].sphere, &c[3].sphere]),
             0xF,
         );
         from += 4;
     }
     let last = items.len() - 1;
-    let rest = [0, 1, 2, 3].map(|j| &items[(from + j).min(last)].sphere);
+    // Written out: `[0, 1, 2, 3].map(..)` compiled to an out-of-line
+    // `array::try_map` call per leaf (callgrind, W7 points k = 10: ~260
+    // instructions a query).
+    let at = |j: usize| &items[(from + j).min(last)].sphere;
+    let rest = [at(0), at(1), at(2), at(3)];
     quad(
         pass,
         m,
         from,
-        beyond(rest),
+        beyond.beyond(rest),
         (1 << quads.remainder().len()) - 1,
     )
 }

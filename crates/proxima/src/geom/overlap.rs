@@ -732,7 +732,7 @@ impl EntryBound {
         let Some(clip) = &self.clip else {
             return [Some(0.0); 8];
         };
-        // A loop, not `.map(..)`: that was an out-of-line call per node
+        // A loop, not `[T; 8]::map`: that was an out-of-line call per node
         // too (see `clip_octants`).
         let mut out = [None; 8];
         for (o, c) in out.iter_mut().zip(clip.clip_octants(halves)) {
@@ -1211,8 +1211,9 @@ impl RayClip {
     #[inline(always)]
     pub(crate) fn clip_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [Option<(f64, f64)>; 8] {
         // Written out: as `[0, 1, 2].map(..)` this compiled to an
-        // out-of-line `array::try_map` call per node (callgrind, W8
-        // octree first hits: ~100 instructions a call, 11% of a sweep's).
+        // out-of-line `array::try_map` call per node; with `enter_octants`'
+        // `[T; 8]::map`, 11% of a W8 octree first-hit sweep's instructions
+        // (callgrind; docs/bench/run19-02adaaa.txt).
         let axis = |a: usize| {
             let [(l0, h0), (l1, h1)] = halves[a];
             [self.slab(a, l0, h0), self.slab(a, l1, h1)]

@@ -551,14 +551,16 @@ const QUAD_COUNT: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
 /// The leaf step's four-lane pre-test: a bit per lane whose sphere surely
 /// cannot enter the search's candidate set. A trait with always-inlined
 /// methods rather than a closure: `list_passers` calls it at two sites, and
-/// the closure was compiled out of line there (callgrind, W7 points
-/// k = 10: a call per leaf, ~35 instructions each).
+/// the closure was compiled out of line at the second (the last quad's:
+/// a call per leaf, ~35 instructions each; callgrind, W7 points k = 10,
+/// docs/bench/run19-02adaaa.txt).
 trait QuadBeyond {
+    /// Bit `j` set when sphere `s[j]` surely cannot enter. O(1).
     fn beyond(&self, s: [&Sphere; 4]) -> u32;
 }
 
-/// Points (`Metric::Center`, or radius 0): the `f32` squared centre
-/// distance above `t` ([`KBest::sq_threshold_f32`]).
+/// `Metric::Center` (radii ignored): the `f32` squared centre distance
+/// above `t` ([`KBest::sq_threshold_f32`]).
 struct CentresBeyond {
     point: glam::Vec3,
     t: Vec4,
@@ -622,7 +624,7 @@ fn list_passers(items: &[Item], pass: &mut [u8; SEED_MAX + 4], beyond: &impl Qua
     let last = items.len() - 1;
     // Written out: `[0, 1, 2, 3].map(..)` compiled to an out-of-line
     // `array::try_map` call per leaf (callgrind, W7 points k = 10: ~260
-    // instructions a query).
+    // instructions a query; docs/bench/run19-02adaaa.txt).
     let at = |j: usize| &items[(from + j).min(last)].sphere;
     let rest = [at(0), at(1), at(2), at(3)];
     quad(

@@ -35,10 +35,16 @@ use node::{Node, Obj};
 use rustc_hash::FxHashMap;
 use std::ops::ControlFlow;
 
-/// Everything a [`LinearOctree`] is built from. [`OctreeConfig::new`] gives 32
-/// objects per leaf, merge below 16, depth up to 16: on W1 at N = 100k, leaves
+/// Everything a [`LinearOctree`] is built from. [`OctreeConfig::new`] gives 48
+/// objects per leaf, merge below 24, depth up to 16: on W1 at N = 100k, leaves
 /// of up to 32 made a frame (update all + all pairs) about twice as fast as
 /// leaves of up to 8 (fewer nodes to visit; see `examples/octree_w1.rs`).
+/// Leaves of up to 48 against 32 (three alternations, 2026-11-30;
+/// docs/bench/octree-leaf48.txt): W1 100k frame −15 to −26%, W9 −24 to −37%,
+/// W7 kNN at 1M −22 to −33% (one run), at 100k −9 to +1% (spheres at
+/// k ≤ 10 −5 to +6%), W8 sweeps −6 to +2% (ratios to parry3d in the same
+/// run), W4 queries −12 to +8% (rays 0 to +5%); 64 was slower than 48 on W1
+/// and W8.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OctreeConfig {
     /// The box the root cell covers (any finite box; a degenerate one is
@@ -65,8 +71,8 @@ impl OctreeConfig {
     pub fn new(world: Aabb) -> Self {
         OctreeConfig {
             world,
-            max_per_leaf: 32,
-            merge_below: 16,
+            max_per_leaf: 48,
+            merge_below: 24,
             max_depth: 16,
         }
     }

@@ -146,7 +146,7 @@ impl<T> LinearOctree<T> {
             if best.exceeds_sq(p.dist_sq) {
                 break;
             }
-            // The next node's items (a leaf's, up to 32 of them: one line
+            // The next node's items (a leaf's, up to 48 of them: one line
             // per two) and the first items of the two after it in the
             // heap's layout (`BinaryHeap::iter`'s order: the top's children
             // there, likely popped soon; only a hint either way) on their
@@ -158,7 +158,7 @@ impl<T> LinearOctree<T> {
             // alternations), 0.78-0.81 of rstar's time; with the next
             // leaf's first four lines alone it was ~0.85.
             if let Some(next) = heap.peek() {
-                self.nodes[next.node].prefetch_items(16);
+                self.nodes[next.node].prefetch_items(24);
             }
             for after in heap.iter().skip(1).take(2) {
                 self.nodes[after.node].prefetch_items(1);
@@ -459,7 +459,7 @@ impl<T> LinearOctree<T> {
             // instructions and ~13 mispredicts a k = 10 query (callgrind;
             // the loop's exit), hence the size test.
             if self.objects.len() >= PREFETCH_LEAF_MIN_OBJECTS {
-                n.prefetch_items(16);
+                n.prefetch_items(24);
             }
             self.offer_leaf(n, q, filter, best);
             return;

@@ -370,7 +370,7 @@ impl<'a> KBest<'a> {
     /// 24.6, callgrind on `examples/knn_leaf`). Groups of more than
     /// [`SEED_MAX`] change nothing. O(len · k) for `k <=` [`LINEAR_MAX_K`],
     /// else O(len) (the octree's only: a leaf of at least `k` items, which
-    /// for `k > 32` takes a `max_per_leaf` above the default or the depth
+    /// for `k > 48` takes a `max_per_leaf` above the default or the depth
     /// cap).
     ///
     /// When `k <=` [`LINEAR_MAX_K`] and `k <= s2.len() <=` [`SEED_MAX`], it

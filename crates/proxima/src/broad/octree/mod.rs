@@ -37,14 +37,15 @@ use std::ops::ControlFlow;
 
 /// Everything a [`LinearOctree`] is built from. [`OctreeConfig::new`] gives 48
 /// objects per leaf, merge below 24, depth up to 16: on W1 at N = 100k, leaves
-/// of up to 32 made a frame (update all + all pairs) about twice as fast as
-/// leaves of up to 8 (fewer nodes to visit; see `examples/octree_w1.rs`).
-/// Leaves of up to 48 against 32 (three alternations, 2026-11-30;
-/// docs/bench/octree-leaf48.txt): W1 100k frame −15 to −26%, W9 −24 to −37%,
-/// W7 kNN at 1M −22 to −33% (one run), at 100k −9 to +1% (spheres at
-/// k ≤ 10 −5 to +6%), W8 sweeps −6 to +2% (ratios to parry3d in the same
-/// run), W4 queries −12 to +8% (rays 0 to +5%); 64 was slower than 48 on W1
-/// and W8.
+/// of up to 32 (the earlier default) made a frame (update all + all pairs)
+/// about twice as fast as leaves of up to 8 (fewer nodes to visit; see
+/// `examples/octree_w1.rs`). Leaves of up to 48 against 32 (three
+/// alternations, 2026-11-30, with the kNN searches' leaf prefetch widened
+/// from 16 to 24 lines in the same build; docs/bench/octree-leaf48.txt): W1
+/// 100k frame −15 to −26%, W9 −24 to −37%, W7 kNN at 1M −22 to −33% (one
+/// run), at 100k −9 to +1% (spheres at k ≤ 10 −5 to +6%), W8 sweeps −7 to
+/// +2% (ratios to parry3d in the same run), W4 queries −12 to +8% (rays 0 to
+/// +5%). 64 (one run against 48) was slower on W1 and W8 and faster on W9.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OctreeConfig {
     /// The box the root cell covers (any finite box; a degenerate one is

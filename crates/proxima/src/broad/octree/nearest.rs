@@ -156,7 +156,9 @@ impl<T> LinearOctree<T> {
             // of the search's samples at 1M (`perf`, W7 spheres k = 100):
             // with them, 29.6-31.1 -> 22.3-22.6 µs a query (six
             // alternations), 0.78-0.81 of rstar's time; with the next
-            // leaf's first four lines alone it was ~0.85.
+            // leaf's first four lines alone it was ~0.85. (Measured with
+            // leaves of up to 32 and 16 lines; 24 cover the 48 of today's
+            // default.)
             if let Some(next) = heap.peek() {
                 self.nodes[next.node].prefetch_items(24);
             }
@@ -455,7 +457,8 @@ impl<T> LinearOctree<T> {
             // cached already (the first descent's leaf is the one nothing
             // prefetched before). W7 spheres 1M (three alternations):
             // k = 10 0.80-0.85 -> 0.72-0.78 of rstar's time, k = 1 0.49-0.56
-            // -> 0.49-0.53. At 100k it gained nothing and cost ~0.4k
+            // -> 0.49-0.53 (leaves of up to 32 then, 16 lines; 24 now for
+            // 48). At 100k it gained nothing and cost ~0.4k
             // instructions and ~13 mispredicts a k = 10 query (callgrind;
             // the loop's exit), hence the size test.
             if self.objects.len() >= PREFETCH_LEAF_MIN_OBJECTS {

@@ -649,7 +649,7 @@ fn sweeps_over_leaves_of_every_size_match_brute_force() {
     use std::ops::ControlFlow;
     let mut rng = Pcg64::seed_from_u64(91);
     let p = |rng: &mut Pcg64| vec3(rng.gen(), rng.gen(), rng.gen()) * 64.0;
-    for leaf in [1u32, 3, 4, 5, 6, 7, 9, 32] {
+    for leaf in [1u32, 3, 4, 5, 6, 7, 9, 32, 48] {
         let mut t = LinearOctree::with_config(cfg(leaf, leaf / 2, 21)).unwrap();
         let mut spheres = Vec::new();
         for i in 0..1500usize {

@@ -507,8 +507,12 @@ impl<T> LinearOctree<T> {
         // than the plain reads they replace, which held up the instructions
         // behind them: `knn_leaf 100000 10 50000 32` median 0.94× the time
         // (eight alternations, faster in six), k = 1 unchanged.
-        for &o in &order[..m] {
-            self.prefetch_node(n.children[o as usize]);
+        // All eight, whether pruned or not, an absent one as this node
+        // (already cached): a loop over the `m` visited ones mispredicted its
+        // exit. `knn_leaf 100000 10 50000 48`: 0.976-0.994 of the time (8 of
+        // 8 alternations), −2.2% mispredicts, +1.9% instructions (callgrind).
+        for &ch in &n.children {
+            self.prefetch_node(if ch == NONE { i } else { ch });
         }
         for (j, &o) in order[..m].iter().enumerate() {
             if let Some(&next) = order[..m].get(j + 1) {

@@ -43,9 +43,10 @@ use std::ops::ControlFlow;
 /// alternations, 2026-11-30, with the kNN searches' leaf prefetch widened
 /// from 16 to 24 lines in the same build; docs/bench/octree-leaf48.txt): W1
 /// 100k frame −15 to −26%, W9 −24 to −37%, W7 kNN at 1M −22 to −33% (one
-/// run), at 100k −9 to +1% (spheres at k ≤ 10 −5 to +6%), W8 sweeps −7 to
-/// +2% (ratios to parry3d in the same run), W4 queries −12 to +8% (rays 0 to
-/// +5%). 64 (one run against 48) was slower on W1 and W8 and faster on W9.
+/// run; 10–20% between runs there), at 100k −9 to +1% (spheres at k ≤ 10 −5
+/// to +6%), W8 sweeps −7 to +2% (ratios to parry3d in the same run), W4
+/// queries −12 to +8% (rays 0 to +5%). 64 (one run against 48, within the
+/// noise) was slower on W1 and W8 and faster on W9.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OctreeConfig {
     /// The box the root cell covers (any finite box; a degenerate one is

@@ -499,18 +499,19 @@ impl<T> LinearOctree<T> {
             order[m] = o;
             m += (mask >> o) as usize & 1;
         }
-        // Every child to be visited on its way now, so that their cache
-        // misses overlap instead of following one another (`perf` put ~10%
-        // of the search's samples on the first read of a node and ~15% on a
-        // leaf's first item, each waiting for the one before), and the next
-        // child's first items while this one is searched. Prefetches rather
-        // than the plain reads they replace, which held up the instructions
-        // behind them: `knn_leaf 100000 10 50000 32` median 0.94× the time
-        // (eight alternations, faster in six), k = 1 unchanged.
-        // All eight, whether pruned or not, an absent one as this node
-        // (already cached): a loop over the `m` visited ones mispredicted its
-        // exit. `knn_leaf 100000 10 50000 48`: 0.976-0.994 of the time (8 of
-        // 8 alternations), −2.2% mispredicts, +1.9% instructions (callgrind).
+        // The children on their way now, so that their cache misses overlap
+        // instead of following one another (`perf` put ~10% of the search's
+        // samples on the first read of a node and ~15% on a leaf's first
+        // item, each waiting for the one before), and the next child's first
+        // items while this one is searched. Prefetches rather than the plain
+        // reads they replace, which held up the instructions behind them
+        // (the loop over the `m` to visit, leaves of 32: `knn_leaf 100000 10
+        // 50000 32` median 0.94× the time, eight alternations, faster in
+        // six; k = 1 unchanged). Now all eight, pruned or not, an absent one
+        // as this node (already cached), so that the loop has no
+        // data-dependent exit: `knn_leaf 100000 10 50000 48` 0.976-0.994 of
+        // the time (8 of 8 alternations), mispredicts −2.2% and
+        // instructions +1.9% (callgrind).
         for &ch in &n.children {
             self.prefetch_node(if ch == NONE { i } else { ch });
         }

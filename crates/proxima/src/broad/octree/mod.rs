@@ -68,13 +68,17 @@ pub struct OctreeConfig {
     pub max_depth: u32,
 }
 
+/// [`OctreeConfig::new`]'s `max_per_leaf`, named so that what is sized by
+/// it (the kNN searches' whole-leaf prefetch, `nearest.rs`) follows it.
+pub(super) const DEFAULT_MAX_PER_LEAF: u32 = 48;
+
 impl OctreeConfig {
     /// The default tuning over `world`.
     pub fn new(world: Aabb) -> Self {
         OctreeConfig {
             world,
-            max_per_leaf: 48,
-            merge_below: 24,
+            max_per_leaf: DEFAULT_MAX_PER_LEAF,
+            merge_below: DEFAULT_MAX_PER_LEAF / 2,
             max_depth: 16,
         }
     }

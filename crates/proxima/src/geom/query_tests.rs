@@ -997,3 +997,81 @@ fn entry_octants_equal_entry_per_box() {
     }
     assert!(some > 20_000, "too few entered boxes: {some}");
 }
+
+/// `EntryBound::reach_octants` (the octree leaf's octant filter for first
+/// hits) keeps every box of `halves` that the cast touches up to parameter
+/// `t`, by the exact tests (`ray_aabb` with `max_t` lowered to `t`;
+/// `sweep_aabb` of the sweep cut at `t`), for rays and sweeps (with and
+/// without a magnitude), `t` from 0 to past the end and ∞. Coordinates are
+/// small multiples of 1 and 1/64, so that the cut sweep's end point and the
+/// boxes grown by the radius are exact in `f32` and the oracle rounds
+/// nothing; the halves may be infinite, degenerate or inverted. It must also
+/// drop boxes (a filter that keeps all 8 passes the first part).
+#[test]
+fn reach_octants_keep_every_box_touched_by_t() {
+    let nice =
+        |rng: &mut Pcg64| rng.gen_range(-8i32..=8) as f32 * [1.0, 1.0 / 64.0][rng.gen_range(0..2)];
+    let nv = |rng: &mut Pcg64| vec3(nice(rng), nice(rng), nice(rng));
+    let mut rng = Pcg64::seed_from_u64(71);
+    let (mut touched, mut dropped) = (0u32, 0u32);
+    for k in 0..60_000usize {
+        let o = nv(&mut rng);
+        let mut d = nv(&mut rng);
+        if k % 4 == 0 {
+            d[rng.gen_range(0..3)] = 0.0;
+        }
+        if d == Vec3::ZERO {
+            d = Vec3::Y;
+        }
+        let t = [0.0f32, 0.25, 0.5, 1.0, 3.0, f32::INFINITY][k % 6];
+        let mut halves = [[(0.0f32, 0.0f32); 2]; 3];
+        for h in halves.iter_mut().flatten() {
+            let (a, b) = (nice(&mut rng) * 4.0, nice(&mut rng) * 4.0);
+            *h = match rng.gen_range(0..10) {
+                0 => (f32::NEG_INFINITY, b),
+                1 => (a, f32::INFINITY),
+                2 => (a, a),
+                3 => (a.max(b), a.min(b)),
+                _ => (a.min(b), a.max(b)),
+            };
+        }
+        let boxes: [Aabb; 8] = std::array::from_fn(|i| {
+            let pick = |a: usize| halves[a][(i >> a) & 1];
+            let (x, y, z) = (pick(0), pick(1), pick(2));
+            Aabb::new(vec3(x.0, y.0, z.0), vec3(x.1, y.1, z.1))
+        });
+        let (entry, hits): (EntryBound, [bool; 8]) = if k % 2 == 0 {
+            let max_t = [f32::INFINITY, 1.0, 0.5][k % 3];
+            let ray = Ray::with_max_t(o, d, max_t);
+            let cut = Ray::with_max_t(o, d, max_t.min(t));
+            (
+                EntryBound::ray(&ray),
+                boxes.map(|b| ray_aabb(&cut, &b).is_some()),
+            )
+        } else {
+            let radius = nice(&mut rng).abs();
+            let sw = SphereSweep::new(o, o + d, radius);
+            let cut = SphereSweep::new(o, o + d * t.min(1.0), radius);
+            let m = [0.0, 64.0][k % 3 / 2];
+            (
+                EntryBound::sweep(&sw, m),
+                boxes.map(|b| sweep_aabb(&cut, &b).is_some()),
+            )
+        };
+        let reach = entry.reach_octants(halves, t);
+        for (i, &hit) in hits.iter().enumerate() {
+            let kept = reach >> i & 1 == 1;
+            assert!(
+                kept || !hit,
+                "k={k} t={t} octant {i} {:?} o={o} d={d}",
+                boxes[i]
+            );
+            touched += hit as u32;
+            dropped += !kept as u32;
+        }
+    }
+    assert!(
+        touched > 20_000 && dropped > 20_000,
+        "{touched} touched, {dropped} dropped"
+    );
+}

@@ -71,6 +71,7 @@ impl<T> LinearOctree<T> {
         self.counters.splits += 1;
         let mut items = std::mem::take(&mut self.nodes[i].items);
         self.nodes[i].leaf = false;
+        self.octants[i as usize] = [0; 8];
         let shift = 3 * (MAX_DEPTH - d - 1);
         for it in items.drain(..) {
             let key = self.obj(it.handle).key;
@@ -162,6 +163,7 @@ impl<T> LinearOctree<T> {
         if old.capacity() > 0 {
             self.spare.push(old);
         }
+        self.remark_octants(x);
     }
 
     /// Moves every item below node `i` into `out` and frees the nodes.

@@ -165,6 +165,17 @@ pub struct LinearOctree<T> {
     slack: f32,
     objects: Arena<Obj<T>>,
     nodes: Pool<Node>,
+    /// Each leaf's items by octant, by node index: bit `s` of
+    /// `octants[leaf][k]` is set when the item at slot `s < 64` has its
+    /// (clamped) centre in octant `k` of the leaf's cell (the key's next
+    /// three bits), so that a first-hit search scans only the items of the
+    /// octants its cast reaches (`ray.rs`), as if the leaf were split but
+    /// without the nodes. Kept by every change to a leaf's items (`validate`
+    /// checks them). Zero for inner nodes and for leaves at `MAX_DEPTH` (no
+    /// octants there); slots from 64 on are in no mask, and scans take all
+    /// of them. Beside the nodes, not in them: inside (88 -> 152 bytes a
+    /// node) W1's updates took 8-10% longer in three alternations.
+    octants: Vec<[u64; 8]>,
     map: FxHashMap<u64, u32>,
     root: u32,
     /// Emptied item lists kept for new leaves, so steady-state moves do not
@@ -216,6 +227,7 @@ impl<T> LinearOctree<T> {
             slack,
             objects: Arena::new(),
             nodes: Pool::default(),
+            octants: Vec::new(),
             map: FxHashMap::default(),
             root: 0,
             spare: Vec::new(),

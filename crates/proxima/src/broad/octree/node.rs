@@ -9,9 +9,23 @@ use crate::geom::{Aabb, Sphere};
 use crate::prefetch::prefetch;
 use crate::Handle;
 use glam::Vec3;
+use std::ops::ControlFlow;
 
 /// "No node" in parent/child links.
 pub(super) const NONE: u32 = u32::MAX;
+
+/// The octant of a cell at depth `d` that holds depth-21 key `key` (which
+/// lies in that cell), or `None` at [`MAX_DEPTH`]. O(1).
+#[inline]
+pub(super) fn octant_of(key: u64, d: u32) -> Option<usize> {
+    (d < MAX_DEPTH).then(|| ((key >> (3 * (MAX_DEPTH - d - 1))) & 7) as usize)
+}
+
+/// Slot `s`'s bit in an octant mask (none from 64 on).
+#[inline]
+pub(super) fn bit(s: usize) -> u64 {
+    1u64.checked_shl(s as u32).unwrap_or(0)
+}
 
 /// An object as its leaf stores it: the sphere is copied here so that scans of a
 /// leaf read contiguous memory. 32 bytes.
@@ -73,6 +87,71 @@ impl Node {
             prefetch(it);
         }
     }
+
+    /// Calls `f` with this leaf's items (at depth `d`) that lie in the
+    /// octants of `reach` (bit `k` for octant `k` of its cell; `octants` are
+    /// its masks, `LinearOctree::octants`), four at a time for a four-lane pre-test, and a
+    /// mask of the lanes that hold them: a last group of fewer is padded
+    /// with its first item, those lanes off. With all 8 octants (or at
+    /// [`MAX_DEPTH`], where there are none) the items go in slot order in
+    /// chunks; otherwise the slots come off the octants' masks four at a
+    /// time without a branch each, then the slots from 64 on, which no mask
+    /// holds. (A loop that stopped at the mask's last bit mispredicted its
+    /// exit once a group: W8 first hits 77 -> 64 mispredicts a sweep,
+    /// callgrind.) Stops at the first `Break`. O(items visited).
+    #[inline(always)]
+    pub(super) fn for_each_quad<B>(
+        &self,
+        octants: &[u64; 8],
+        d: u32,
+        reach: u32,
+        mut f: impl FnMut([&Item; 4], u32) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
+        let items = &self.items;
+        let rest = if reach & 0xFF == 0xFF || d >= MAX_DEPTH {
+            &items[..]
+        } else {
+            let mut live = 0;
+            for (k, m) in octants.iter().enumerate() {
+                live |= m & 0u64.wrapping_sub(((reach >> k) & 1) as u64);
+            }
+            while live != 0 {
+                let first = live.trailing_zeros() as usize;
+                let mut quad = [first; 4];
+                let mut valid = 0u32;
+                for (j, q) in quad.iter_mut().enumerate() {
+                    let some = live != 0;
+                    *q = if some {
+                        live.trailing_zeros() as usize
+                    } else {
+                        first
+                    };
+                    valid |= (some as u32) << j;
+                    live &= live.wrapping_sub(1);
+                }
+                f(
+                    [
+                        &items[quad[0]],
+                        &items[quad[1]],
+                        &items[quad[2]],
+                        &items[quad[3]],
+                    ],
+                    valid,
+                )?;
+            }
+            items.get(64..).unwrap_or(&[])
+        };
+        let mut quads = rest.chunks_exact(4);
+        for q in &mut quads {
+            f([&q[0], &q[1], &q[2], &q[3]], 0xF)?;
+        }
+        let r = quads.remainder();
+        if let Some(first) = r.first() {
+            let at = |j: usize| r.get(j).unwrap_or(first);
+            f([at(0), at(1), at(2), at(3)], (1 << r.len()) - 1)?;
+        }
+        ControlFlow::Continue(())
+    }
 }
 
 impl<T> LinearOctree<T> {
@@ -101,6 +180,12 @@ impl<T> LinearOctree<T> {
             groups: 0,
             masks: 0,
         });
+        // A freed node's slot comes back with its masks cleared.
+        let at = i as usize;
+        if self.octants.len() <= at {
+            self.octants.resize(at + 1, [0; 8]);
+        }
+        self.octants[at] = [0; 8];
         self.map.insert(code.raw(), i);
         self.per_depth[code.depth() as usize] += 1;
         if parent != NONE {
@@ -232,8 +317,32 @@ impl<T> LinearOctree<T> {
         let o = self.obj_mut(item.handle);
         o.leaf = leaf;
         o.slot = slot;
-        let filter = o.filter;
+        let (filter, key) = (o.filter, o.key);
+        self.mark_octant(leaf, slot, key);
         self.widen_filters(leaf, filter);
+    }
+
+    /// Sets slot `slot`'s bit in the octant mask of leaf `leaf` that holds
+    /// `key` (see `LinearOctree::octants`; nothing at [`MAX_DEPTH`] or from slot
+    /// 64 on). The slot's bit must be clear in every mask. O(1).
+    #[inline]
+    pub(super) fn mark_octant(&mut self, leaf: u32, slot: u32, key: u64) {
+        if let Some(k) = octant_of(key, self.nodes[leaf].code.depth()) {
+            self.octants[leaf as usize][k] |= bit(slot as usize);
+        }
+    }
+
+    /// Rebuilds leaf `leaf`'s octant masks from its items' keys. O(items).
+    pub(super) fn remark_octants(&mut self, leaf: u32) {
+        let n = &self.nodes[leaf];
+        let d = n.code.depth();
+        let mut octants = [0u64; 8];
+        for (slot, it) in n.items.iter().take(64).enumerate() {
+            if let Some(k) = octant_of(self.obj(it.handle).key, d) {
+                octants[k] |= 1 << slot;
+            }
+        }
+        self.octants[leaf as usize] = octants;
     }
 
     /// ORs `filter` into the filter bits of `from` and its ancestors, stopping
@@ -255,10 +364,20 @@ impl<T> LinearOctree<T> {
     /// slot) and returns it.
     #[inline]
     pub(super) fn take_item(&mut self, leaf: u32, slot: u32) -> Item {
-        let items = &mut self.nodes[leaf].items;
-        let item = items.swap_remove(slot as usize);
-        if let Some(moved) = items.get(slot as usize).map(|m| m.handle) {
-            self.obj_mut(moved).slot = slot;
+        let n = &mut self.nodes[leaf];
+        let last = n.items.len() - 1;
+        let item = n.items.swap_remove(slot as usize);
+        // The slot and the last one leave their masks; the item moved from
+        // the last slot (if any) is marked at its new one.
+        let gone = bit(slot as usize) | bit(last);
+        for m in &mut self.octants[leaf as usize] {
+            *m &= !gone;
+        }
+        if let Some(moved) = n.items.get(slot as usize).map(|m| m.handle) {
+            let o = self.obj_mut(moved);
+            o.slot = slot;
+            let key = o.key;
+            self.mark_octant(leaf, slot, key);
         }
         item
     }
@@ -330,6 +449,7 @@ impl<T> LinearOctree<T> {
     pub(super) fn clear_all(&mut self) {
         self.objects = Arena::new();
         self.nodes = Pool::default();
+        self.octants = Vec::new();
         self.map = Default::default();
         self.spare = Vec::new();
         self.per_depth = [0; MAX_DEPTH as usize + 1];

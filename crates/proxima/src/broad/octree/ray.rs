@@ -2,12 +2,14 @@
 //! loose boxes, pruning every subtree the cast enters after the best hit found
 //! so far.
 
+use super::code::MAX_DEPTH;
 use super::node::{Item, NONE};
 use super::query::child_coords;
 use super::LinearOctree;
 use crate::broad::walk::{Cast, Contact};
 use crate::broad::{Filter, RayHit};
 use crate::geom::overlap::EntryBound;
+use std::ops::ControlFlow;
 
 /// A subtree is skipped only when its box entry `t0` exceeds the best hit by more
 /// than this relative margin: the box and sphere entry parameters are rounded
@@ -75,27 +77,44 @@ impl<T> LinearOctree<T> {
                     }
                 }
             };
-            // Four at a time through the cast's SIMD pre-test, when it has
-            // one: the leaves' clear misses are most of a sweep's spheres
+            // Only the items of the octants of the leaf's cell (the boxes a
+            // split would give; `LinearOctree::octants`) that the cast's box
+            // up to the best hit so far reaches, and those no mask holds
+            // (W8 first hits, callgrind as below: 10.6k -> 9.7k
+            // instructions, 66 -> 45 L1 data misses and 72 -> 65
+            // mispredicted branches a sweep).
+            let reach = if d < MAX_DEPTH {
+                let limit = best.map_or(f32::INFINITY, |b| b.t + PRUNE_MARGIN * (b.t.abs() + 1.0));
+                entry.reach_octants(self.child_halves(n, c, d), limit)
+            } else {
+                0xFF
+            };
+            // Four at a time through the cast's SIMD pre-test where it has
+            // one: the clear misses are most of a sweep's candidates
             // (callgrind, `w8 --n 100000 --queries 5000 --reps 1 --check 0
             // --only LinearOctree`: 16.2k -> 12.5k instructions a first-hit
-            // sweep).
-            let mut quads = n
-                .items
-                .chunks_exact(if X::HAS_MISSES4 { 4 } else { usize::MAX });
-            for q in &mut quads {
-                let mut live = !test.misses4([0, 1, 2, 3].map(|j| &q[j].sphere)) & 0xF;
-                while live != 0 {
-                    // Its lane ran the pre-test already (conservative, so
-                    // the exact test alone gives `contact`'s answer).
-                    let it = &q[live.trailing_zeros() as usize];
-                    offer(test.contact_after_misses4(&it.sphere), it, best);
-                    live &= live - 1;
+            // sweep, before the octant masks).
+            let _ = n.for_each_quad::<()>(&self.octants[i as usize], d, reach, |q, valid| {
+                if X::HAS_MISSES4 {
+                    let spheres = [&q[0].sphere, &q[1].sphere, &q[2].sphere, &q[3].sphere];
+                    let mut lanes = !test.misses4(spheres) & valid;
+                    while lanes != 0 {
+                        // Its lane ran the pre-test already (conservative,
+                        // so the exact test alone gives `contact`'s answer).
+                        let it = q[lanes.trailing_zeros() as usize];
+                        offer(test.contact_after_misses4(&it.sphere), it, best);
+                        lanes &= lanes - 1;
+                    }
+                } else {
+                    let mut lanes = valid;
+                    while lanes != 0 {
+                        let it = q[lanes.trailing_zeros() as usize];
+                        offer(test.contact(&it.sphere), it, best);
+                        lanes &= lanes - 1;
+                    }
                 }
-            }
-            for it in quads.remainder() {
-                offer(test.contact(&it.sphere), it, best);
-            }
+                ControlFlow::Continue(())
+            });
             return;
         }
         // The children's boxes from this node's extent: 12 slab parameters

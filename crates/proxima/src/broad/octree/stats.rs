@@ -85,7 +85,8 @@ impl<T> LinearOctree<T> {
 
     /// Bytes held: the struct, the object arena, the node pool, the hash map's
     /// table (buckets of key + value plus one control byte each, as hashbrown
-    /// lays it out), every leaf's item list and the spare lists (capacities).
+    /// lays it out), every leaf's item list, the leaves' octant masks and the
+    /// spare lists (capacities).
     pub(super) fn memory(&self) -> usize {
         let map_buckets = if self.map.capacity() == 0 {
             0
@@ -107,6 +108,7 @@ impl<T> LinearOctree<T> {
         size_of::<Self>()
             + self.objects.heap_bytes()
             + self.nodes.heap_bytes()
+            + self.octants.capacity() * size_of::<[u64; 8]>()
             + map_bytes
             + items
             + spare

@@ -641,23 +641,47 @@ fn nearest_over_a_full_leaf_of_duplicates_at_the_depth_cap() {
 
 /// Sweep selections (all hits) and first hits against brute force over
 /// leaves of every size, so that the four-wide pre-test's quads and its
-/// remainder of 0-3 spheres both run: random sweeps, zero-length ones, radius
-/// 0, grazes at the summed radii from a stored sphere, and an early stop.
+/// remainder of 0-3 spheres both run, and the first hits' octant filter
+/// (`LinearOctree::octants`) on leaves of over 64 items (slots from 64 on are in
+/// no mask) and on leaves at the depth cap (no octants: four clusters of
+/// equal centres): random sweeps, zero-length ones, radius 0, grazes at the
+/// summed radii from a stored sphere, and an early stop.
 #[test]
 fn sweeps_over_leaves_of_every_size_match_brute_force() {
     use crate::geom::{overlap, SphereSweep};
     use std::ops::ControlFlow;
     let mut rng = Pcg64::seed_from_u64(91);
     let p = |rng: &mut Pcg64| vec3(rng.gen(), rng.gen(), rng.gen()) * 64.0;
-    for leaf in [1u32, 3, 4, 5, 6, 7, 9, 32, 48] {
+    let twins = [0, 1, 2, 3].map(|_| p(&mut rng));
+    for leaf in [1u32, 3, 4, 5, 6, 7, 9, 32, 48, 400] {
         let mut t = LinearOctree::with_config(cfg(leaf, leaf / 2, 21)).unwrap();
         let mut spheres = Vec::new();
         for i in 0..1500usize {
-            let s = Sphere::new(p(&mut rng), rng.gen_range(0.0..2.0));
+            let c = if i % 100 < 3 {
+                twins[i % 4]
+            } else {
+                p(&mut rng)
+            };
+            let s = Sphere::new(c, rng.gen_range(0.0..2.0));
             t.insert(s, i).unwrap();
             spheres.push(s);
         }
         t.validate().unwrap();
+        let (mut deepest, mut fullest) = (0, 0);
+        t.for_each_leaf(|code, objects| {
+            deepest = deepest.max(code.depth());
+            fullest = fullest.max(objects);
+        });
+        assert_eq!(
+            deepest == MAX_DEPTH,
+            leaf <= 9,
+            "leaf {leaf}: depth {deepest}"
+        );
+        assert_eq!(
+            fullest > 64,
+            leaf == 400,
+            "leaf {leaf}: {fullest} in a leaf"
+        );
         let (mut hits, mut firsts) = (0, 0);
         for j in 0..600 {
             let radius = if j % 3 == 0 {

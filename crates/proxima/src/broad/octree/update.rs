@@ -4,7 +4,7 @@
 //! of the new centre.
 
 use super::code::{Face, LocationCode, MAX_DEPTH};
-use super::node::Item;
+use super::node::{bit, octant_of, Item};
 use super::LinearOctree;
 use crate::geom::Sphere;
 use crate::Handle;
@@ -14,7 +14,7 @@ impl<T> LinearOctree<T> {
     pub(super) fn move_obj(&mut self, h: Handle, sphere: Sphere) {
         let (key, ext) = self.placement(&sphere);
         let o = self.obj_mut(h);
-        let (s, slot, old_ext) = (o.leaf, o.slot, o.ext);
+        let (s, slot, old_ext, old_key) = (o.leaf, o.slot, o.ext, o.key);
         o.sphere = sphere;
         o.key = key;
         o.ext = ext;
@@ -25,9 +25,17 @@ impl<T> LinearOctree<T> {
         if cell == s_code {
             // Same leaf: only the stored sphere and the bounds change.
             self.counters.same_leaf_moves += 1;
-            let item = &mut self.nodes[s].items[slot as usize];
+            let n = &mut self.nodes[s];
+            let item = &mut n.items[slot as usize];
             item.sphere = sphere;
             item.ext = ext;
+            // The centre may have crossed into another octant of the leaf.
+            if octant_of(key, d) != octant_of(old_key, d) {
+                for m in &mut self.octants[s as usize] {
+                    *m &= !bit(slot as usize);
+                }
+                self.mark_octant(s, slot, key);
+            }
             if ext > old_ext {
                 self.grow_extent(s, ext);
             } else if ext < old_ext && old_ext >= self.nodes[s].max_extent {

@@ -1,7 +1,7 @@
 //! `validate()`: every invariant of the octree, checked from scratch.
 
 use super::code::{LocationCode, MAX_DEPTH};
-use super::node::NONE;
+use super::node::{bit, octant_of, NONE};
 use super::query::child_coords;
 use super::LinearOctree;
 use crate::{Error, Result};
@@ -158,11 +158,37 @@ impl<T> LinearOctree<T> {
                 }
                 sub.max_ext = sub.max_ext.max(it.ext);
             }
+            // Leaf scans take only the slots of the octants a query reaches,
+            // judged by the octants' loose boxes (`child_halves`).
+            let mut octants = [0u64; 8];
+            for (slot, it) in n.items.iter().enumerate() {
+                if let Some(k) = octant_of(self.obj(it.handle).key, d) {
+                    octants[k] |= bit(slot);
+                    let h = self.child_halves(n, c, d);
+                    let (lo, hi) = (it.sphere.aabb().min, it.sphere.aabb().max);
+                    let inside = (0..3).all(|a| {
+                        let (l, u) = h[a][(k >> a) & 1];
+                        le(l, lo[a]) && le(hi[a], u)
+                    });
+                    if !inside {
+                        return fail(format!(
+                            "sphere {:?} outside the loose box of its octant {k} of {:?}",
+                            it.sphere, n.code
+                        ));
+                    }
+                }
+            }
+            if octants != self.octants[i as usize] {
+                return fail(format!("octant masks of leaf {:?} are wrong", n.code));
+            }
             sub.count = n.items.len() as u32;
             sub.items = n.items.len();
         } else {
             if !n.items.is_empty() {
                 return fail(format!("inner node {:?} holds items", n.code));
+            }
+            if self.octants[i as usize] != [0; 8] {
+                return fail(format!("inner node {:?} has octant masks", n.code));
             }
             if n.children.iter().all(|&ch| ch == NONE) {
                 return fail(format!("inner node {:?} has no children", n.code));

@@ -1309,8 +1309,13 @@ impl RayClip {
                 far = exit;
             }
         }
-        let t0 = widen(near, false).max(0.0);
-        let t1 = widen(far, true).min(self.max_t);
+        // `widen(near, false).max(0.0)` and `widen(far, true)` without the
+        // sign test: a negative `near` clamps to 0 either way, and a
+        // negative `far` leaves the interval empty either way (`t0 >= 0`),
+        // so the answers are the same; ~6% of a W8 octree first-hit
+        // sweep's instructions were in those sign tests (16 a node).
+        let t0 = (near * (1.0 - CLIP_WIDEN)).max(0.0);
+        let t1 = (far * (1.0 + CLIP_WIDEN)).min(self.max_t);
         (t0 <= t1).then_some((t0, t1))
     }
 

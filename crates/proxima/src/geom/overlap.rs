@@ -726,9 +726,15 @@ impl EntryBound {
 
     /// [`EntryBound::enter`] of the 8 boxes made of the per-axis intervals
     /// `halves` ([`RayClip::clip_octants`]: box `k` takes
-    /// `halves[a][(k >> a) & 1]` on axis `a`), equal to `enter` on each box.
+    /// `halves[a][(k >> a) & 1]` on axis `a`), before its rounding down to
+    /// `f32`: `enter` of each box is this value's `f32` floor, and a search
+    /// that prunes a box when this exceeds an `f32` bound prunes exactly
+    /// when `enter` does, except where the bound is that floor itself (then
+    /// the box's exact entry is above the bound as well). Not rounded: 8
+    /// roundings a node with a branch each, ~4% of a W8 octree first-hit
+    /// sweep's instructions (callgrind).
     #[inline(always)]
-    pub(crate) fn enter_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [Option<f32>; 8] {
+    pub(crate) fn enter_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [Option<f64>; 8] {
         let Some(clip) = &self.clip else {
             return [Some(0.0); 8];
         };
@@ -736,7 +742,7 @@ impl EntryBound {
         // too (see `clip_octants`).
         let mut out = [None; 8];
         for (o, c) in out.iter_mut().zip(clip.clip_octants(halves)) {
-            *o = c.map(|(t0, _)| round_down(t0));
+            *o = c.map(|(t0, _)| t0);
         }
         out
     }

@@ -42,7 +42,9 @@ impl<T> LinearOctree<T> {
             let entry = cast.entry(root.min.abs().max(root.max.abs()).max_element());
             if let Some(t0) = entry.enter(&root) {
                 let test = cast.test();
-                self.first_node(self.root, [0; 3], 0, t0, &test, &entry, filter, &mut best);
+                self.first_node(
+                    self.root, [0; 3], 0, t0 as f64, &test, &entry, filter, &mut best,
+                );
             }
         }
         best
@@ -54,14 +56,16 @@ impl<T> LinearOctree<T> {
         i: u32,
         c: [u32; 3],
         d: u32,
-        t0: f32,
+        t0: f64,
         test: &X,
         entry: &EntryBound,
         filter: Option<Filter>,
         best: &mut Option<RayHit>,
     ) {
         if let Some(b) = best {
-            if t0 > b.t + PRUNE_MARGIN * (b.t.abs() + 1.0) {
+            // `t0` unrounded (`EntryBound::enter_octants`): above an `f32`
+            // bound, the box's exact entry is too.
+            if t0 > (b.t + PRUNE_MARGIN * (b.t.abs() + 1.0)) as f64 {
                 return;
             }
         }
@@ -128,11 +132,11 @@ impl<T> LinearOctree<T> {
         // 74 mispredicted branches a first-hit sweep. Any order finds the
         // same hit; each child is tested against it on entry.
         let near = entry.near_octant();
-        let mut order = [(0.0f32, 0usize); 8];
+        let mut order = [(0.0f64, 0usize); 8];
         let mut m = 0;
         for j in 0..8 {
             let k = near ^ j;
-            order[m] = (enters[k].unwrap_or(f32::INFINITY), k);
+            order[m] = (enters[k].unwrap_or(f64::INFINITY), k);
             m += (n.children[k] != NONE && enters[k].is_some()) as usize;
         }
         for &(ct0, k) in &order[..m] {

@@ -725,26 +725,21 @@ impl EntryBound {
     }
 
     /// [`EntryBound::enter`] of the 8 boxes made of the per-axis intervals
-    /// `halves` ([`RayClip::clip_octants`]: box `k` takes
+    /// `halves` ([`RayClip::entry_octants`]: box `k` takes
     /// `halves[a][(k >> a) & 1]` on axis `a`), before its rounding down to
-    /// `f32`: `enter` of each box is this value's `f32` floor, and a search
-    /// that prunes a box when this exceeds an `f32` bound prunes exactly
-    /// when `enter` does, except where the bound is that floor itself (then
-    /// the box's exact entry is above the bound as well). Not rounded: 8
-    /// roundings a node with a branch each, ~4% of a W8 octree first-hit
-    /// sweep's instructions (callgrind).
+    /// `f32`, and `+∞` where `enter` is `None` (or `Some(∞)`: entered at no
+    /// finite parameter). `enter` of each box is this value's `f32` floor;
+    /// a search that prunes a box when this exceeds an `f32` bound prunes
+    /// exactly when `enter` does, except where the bound is that floor
+    /// itself (then the box's exact entry is above the bound as well). Not
+    /// rounded: 8 roundings a node with a branch each, ~4% of a W8 octree
+    /// first-hit sweep's instructions (callgrind). No branch per box.
     #[inline(always)]
-    pub(crate) fn enter_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [Option<f64>; 8] {
-        let Some(clip) = &self.clip else {
-            return [Some(0.0); 8];
-        };
-        // A loop, not `[T; 8]::map`: that was an out-of-line call per node
-        // too (see `clip_octants`).
-        let mut out = [None; 8];
-        for (o, c) in out.iter_mut().zip(clip.clip_octants(halves)) {
-            *o = c.map(|(t0, _)| t0);
+    pub(crate) fn enter_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [f64; 8] {
+        match &self.clip {
+            Some(clip) => clip.entry_octants(halves),
+            None => [0.0; 8],
         }
-        out
     }
 
     /// The octants among the 8 boxes of `halves` (as in
@@ -1258,14 +1253,17 @@ impl RayClip {
         ])
     }
 
-    /// [`RayClip::clip`] of the 8 boxes whose side on axis `a` is one of the
-    /// two intervals `halves[a]`: box `k` takes `halves[a][(k >> a) & 1]`, as
-    /// an octree's children take their cells' halves. Equal to `clip` on each
-    /// box, bit for bit (the same slab parameters, folded in the same axis
-    /// order), for 12 slab parameters instead of 48: what an octree's cast
-    /// search needs per inner node.
+    /// The entries of [`RayClip::clip`] of the 8 boxes whose side on axis
+    /// `a` is one of the two intervals `halves[a]`: box `k` takes
+    /// `halves[a][(k >> a) & 1]`, as an octree's children take their cells'
+    /// halves. Box `k`'s `t0` from `clip`, bit for bit (the same slab
+    /// parameters, folded in the same axis order), or `+∞` where `clip` is
+    /// `None` (or its `t0` is `+∞`), for 12 slab parameters instead of 48
+    /// and no branch per box (an `Option` per box mispredicted ~10 times a
+    /// W8 octree first-hit sweep, callgrind): what an octree's cast search
+    /// needs per inner node.
     #[inline(always)]
-    pub(crate) fn clip_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [Option<(f64, f64)>; 8] {
+    pub(crate) fn entry_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [f64; 8] {
         // Written out: as `[0, 1, 2].map(..)` this compiled to an
         // out-of-line `array::try_map` call per node; with `enter_octants`'
         // `[T; 8]::map`, 11% of a W8 octree first-hit sweep's instructions
@@ -1276,7 +1274,18 @@ impl RayClip {
         };
         let slabs = [axis(0), axis(1), axis(2)];
         std::array::from_fn(|k| {
-            self.finish([slabs[0][k & 1]?, slabs[1][(k >> 1) & 1]?, slabs[2][k >> 2]?])
+            match (slabs[0][k & 1], slabs[1][(k >> 1) & 1], slabs[2][k >> 2]) {
+                (Some(x), Some(y), Some(z)) => {
+                    let (t0, t1) = self.widened([x, y, z]);
+                    if t0 <= t1 {
+                        t0
+                    } else {
+                        f64::INFINITY
+                    }
+                }
+                // A zero direction component with the origin outside the slab.
+                _ => f64::INFINITY,
+            }
         })
     }
 
@@ -1304,6 +1313,13 @@ impl RayClip {
     /// exit of the three slabs, widened and clipped to `[0, max_t]`.
     #[inline(always)]
     fn finish(&self, slabs: [(f64, f64); 3]) -> Option<(f64, f64)> {
+        let (t0, t1) = self.widened(slabs);
+        (t0 <= t1).then_some((t0, t1))
+    }
+
+    /// [`RayClip::finish`]'s interval before the emptiness test.
+    #[inline(always)]
+    fn widened(&self, slabs: [(f64, f64); 3]) -> (f64, f64) {
         let mut near = f64::NEG_INFINITY;
         let mut far = f64::INFINITY;
         for (enter, exit) in slabs {
@@ -1322,7 +1338,7 @@ impl RayClip {
         // sweep's instructions were in those sign tests (16 a node).
         let t0 = (near * (1.0 - CLIP_WIDEN)).max(0.0);
         let t1 = (far * (1.0 + CLIP_WIDEN)).min(self.max_t);
-        (t0 <= t1).then_some((t0, t1))
+        (t0, t1)
     }
 
     /// An `f64` interval containing the exact coordinate on axis `a` of the

@@ -136,8 +136,8 @@ impl<T> LinearOctree<T> {
         let mut m = 0;
         for j in 0..8 {
             let k = near ^ j;
-            order[m] = (enters[k].unwrap_or(f64::INFINITY), k);
-            m += (n.children[k] != NONE && enters[k].is_some()) as usize;
+            order[m] = (enters[k], k);
+            m += (n.children[k] != NONE && enters[k] < f64::INFINITY) as usize;
         }
         for &(ct0, k) in &order[..m] {
             let ch = n.children[k];

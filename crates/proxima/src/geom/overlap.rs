@@ -732,8 +732,9 @@ impl EntryBound {
     /// a search that prunes a box when this exceeds an `f32` bound prunes
     /// exactly when `enter` does, except where the bound is that floor
     /// itself (then the box's exact entry is above the bound as well). Not
-    /// rounded: 8 roundings a node with a branch each, ~4% of a W8 octree
-    /// first-hit sweep's instructions (callgrind). No branch per box.
+    /// rounded: 8 roundings a node with a branch each, ~1.5% of a W8 octree
+    /// first-hit sweep's instructions and 66 -> 56 mispredicts (callgrind:
+    /// the rounding's branch). No branch per box.
     #[inline(always)]
     pub(crate) fn enter_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [f64; 8] {
         match &self.clip {
@@ -750,9 +751,9 @@ impl EntryBound {
     /// box, which is rounded outward by `2^-50` of its terms, more than the
     /// two roundings of `o + d t`), so a search that scans only these for a
     /// contact before `t` misses none that the slab clip would keep; coarser
-    /// than [`EntryBound::enter_octants`] for a long diagonal cast, but ~20
-    /// `f64` operations and no branch per box instead of 12 slab parameters
-    /// and eight clips. A NaN side or bound keeps the box; a `None` clip
+    /// than [`EntryBound::enter_octants`] for a long diagonal cast, but ~40
+    /// `f64` operations and 12 comparisons for all 8 boxes, no branch,
+    /// instead of 12 slab parameters and eight clips. A NaN side or bound keeps the box; a `None` clip
     /// (an overflowing direction) keeps all 8. O(1).
     #[inline(always)]
     pub(crate) fn reach_octants(&self, halves: [[(f32, f32); 2]; 3], t: f32) -> u32 {
@@ -1265,9 +1266,9 @@ impl RayClip {
     #[inline(always)]
     pub(crate) fn entry_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [f64; 8] {
         // Written out: as `[0, 1, 2].map(..)` this compiled to an
-        // out-of-line `array::try_map` call per node; with `enter_octants`'
-        // `[T; 8]::map`, 11% of a W8 octree first-hit sweep's instructions
-        // (callgrind; docs/bench/run19-02adaaa.txt).
+        // out-of-line `array::try_map` call per node; with the `[T; 8]::map`
+        // that rounded the entries then, 11% of a W8 octree first-hit
+        // sweep's instructions (callgrind; docs/bench/run19-02adaaa.txt).
         let axis = |a: usize| {
             let [(l0, h0), (l1, h1)] = halves[a];
             [self.slab(a, l0, h0), self.slab(a, l1, h1)]
@@ -1317,7 +1318,9 @@ impl RayClip {
         (t0 <= t1).then_some((t0, t1))
     }
 
-    /// [`RayClip::finish`]'s interval before the emptiness test.
+    /// [`RayClip::finish`]'s interval before the emptiness test: apart, so
+    /// that [`RayClip::entry_octants`] can turn an empty one into `+∞`
+    /// without an `Option` per box.
     #[inline(always)]
     fn widened(&self, slabs: [(f64, f64); 3]) -> (f64, f64) {
         let mut near = f64::NEG_INFINITY;

@@ -989,6 +989,19 @@ fn entry_octants_equal_entry_per_box() {
             let want = entry.enter(&b);
             // `+∞` for `None` and for an entry at `+∞`.
             let want = want.filter(|&t| t < f32::INFINITY);
+            // The unrounded entry the octree prunes on is the clip's own,
+            // bit for bit (so at most the exact entry), and its floor is
+            // `enter`'s.
+            let unrounded = match &entry.clip {
+                Some(c) => c.clip(&b).map(|(t0, _)| t0),
+                None => Some(0.0),
+            }
+            .filter(|&t| t < f64::INFINITY);
+            assert_eq!(
+                (*g < f64::INFINITY).then(|| g.to_bits()),
+                unrounded.map(f64::to_bits),
+                "k={k} octant {i} {b:?}"
+            );
             let g = (*g < f64::INFINITY).then(|| round_down(*g));
             assert_eq!(
                 g.map(f32::to_bits),
@@ -1005,18 +1018,22 @@ fn entry_octants_equal_entry_per_box() {
 /// hits) keeps every box of `halves` that the cast touches up to parameter
 /// `t`, by the exact tests (`ray_aabb` with `max_t` lowered to `t`;
 /// `sweep_aabb` of the sweep cut at `t`), for rays and sweeps (with and
-/// without a magnitude), `t` from 0 to past the end and ∞. Coordinates are
-/// small multiples of 1 and 1/64, so that the cut sweep's end point and the
-/// boxes grown by the radius are exact in `f32` and the oracle rounds
-/// nothing; the halves may be infinite, degenerate or inverted. It must also
-/// drop boxes (a filter that keeps all 8 passes the first part).
+/// without a magnitude), `t` from 0 to past the end and ∞. Coordinates
+/// are small multiples of 1 and 1/64, so that the cut sweep's end point and
+/// the boxes grown by the radius are exact in `f32` and the oracle rounds
+/// nothing (not `coarse`'s magnitudes: there `ray_aabb` rounds its
+/// parameters to `f32`, and says "touched" of a box entered an ulp past
+/// `max_t`, which the exact clip and this filter rightly drop); the halves
+/// may be infinite, degenerate or inverted. It must also drop boxes, some of them
+/// reached by the whole cast but not by `t` (a filter that keeps all 8, or
+/// ignores `t`, passes the first part).
 #[test]
 fn reach_octants_keep_every_box_touched_by_t() {
     let nice =
         |rng: &mut Pcg64| rng.gen_range(-8i32..=8) as f32 * [1.0, 1.0 / 64.0][rng.gen_range(0..2)];
     let nv = |rng: &mut Pcg64| vec3(nice(rng), nice(rng), nice(rng));
     let mut rng = Pcg64::seed_from_u64(71);
-    let (mut touched, mut dropped) = (0u32, 0u32);
+    let (mut touched, mut dropped, mut late) = (0u32, 0u32, 0u32);
     for k in 0..60_000usize {
         let o = nv(&mut rng);
         let mut d = nv(&mut rng);
@@ -1043,13 +1060,15 @@ fn reach_octants_keep_every_box_touched_by_t() {
             let (x, y, z) = (pick(0), pick(1), pick(2));
             Aabb::new(vec3(x.0, y.0, z.0), vec3(x.1, y.1, z.1))
         });
-        let (entry, hits): (EntryBound, [bool; 8]) = if k % 2 == 0 {
+        // Whether the cast touches each box by `t`, and at all.
+        let (entry, hits, ever): (EntryBound, [bool; 8], [bool; 8]) = if k % 2 == 0 {
             let max_t = [f32::INFINITY, 1.0, 0.5][k % 3];
             let ray = Ray::with_max_t(o, d, max_t);
             let cut = Ray::with_max_t(o, d, max_t.min(t));
             (
                 EntryBound::ray(&ray),
                 boxes.map(|b| ray_aabb(&cut, &b).is_some()),
+                boxes.map(|b| ray_aabb(&ray, &b).is_some()),
             )
         } else {
             let radius = nice(&mut rng).abs();
@@ -1059,10 +1078,11 @@ fn reach_octants_keep_every_box_touched_by_t() {
             (
                 EntryBound::sweep(&sw, m),
                 boxes.map(|b| sweep_aabb(&cut, &b).is_some()),
+                boxes.map(|b| sweep_aabb(&sw, &b).is_some()),
             )
         };
         let reach = entry.reach_octants(halves, t);
-        for (i, &hit) in hits.iter().enumerate() {
+        for (i, (&hit, &all)) in hits.iter().zip(&ever).enumerate() {
             let kept = reach >> i & 1 == 1;
             assert!(
                 kept || !hit,
@@ -1071,10 +1091,12 @@ fn reach_octants_keep_every_box_touched_by_t() {
             );
             touched += hit as u32;
             dropped += !kept as u32;
+            // Reached by the whole cast, not by `t`, and dropped: `t` counts.
+            late += (all && !kept) as u32;
         }
     }
     assert!(
-        touched > 20_000 && dropped > 20_000,
-        "{touched} touched, {dropped} dropped"
+        touched > 20_000 && dropped > 20_000 && late > 2_000,
+        "{touched} touched, {dropped} dropped, {late} dropped for t"
     );
 }

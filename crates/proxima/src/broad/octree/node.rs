@@ -9,7 +9,6 @@ use crate::geom::{Aabb, Sphere};
 use crate::prefetch::prefetch;
 use crate::Handle;
 use glam::Vec3;
-use std::ops::ControlFlow;
 
 /// "No node" in parent/child links.
 pub(super) const NONE: u32 = u32::MAX;
@@ -97,16 +96,16 @@ impl Node {
     /// chunks; otherwise the slots come off the octants' masks four at a
     /// time without a branch each, then the slots from 64 on, which no mask
     /// holds. (A loop that stopped at the mask's last bit mispredicted its
-    /// exit once a group: W8 first hits 77 -> 64 mispredicts a sweep,
-    /// callgrind.) Stops at the first `Break`. O(items visited).
+    /// exit once a group: W8 first hits 77 -> 64 mispredicts a sweep in an
+    /// intermediate build, callgrind.) O(items visited).
     #[inline(always)]
-    pub(super) fn for_each_quad<B>(
+    pub(super) fn for_each_quad(
         &self,
         octants: &[u64; 8],
         d: u32,
         reach: u32,
-        mut f: impl FnMut([&Item; 4], u32) -> ControlFlow<B>,
-    ) -> ControlFlow<B> {
+        mut f: impl FnMut([&Item; 4], u32),
+    ) {
         let items = &self.items;
         let rest = if reach & 0xFF == 0xFF || d >= MAX_DEPTH {
             &items[..]
@@ -137,20 +136,19 @@ impl Node {
                         &items[quad[3]],
                     ],
                     valid,
-                )?;
+                );
             }
             items.get(64..).unwrap_or(&[])
         };
         let mut quads = rest.chunks_exact(4);
         for q in &mut quads {
-            f([&q[0], &q[1], &q[2], &q[3]], 0xF)?;
+            f([&q[0], &q[1], &q[2], &q[3]], 0xF);
         }
         let r = quads.remainder();
         if let Some(first) = r.first() {
             let at = |j: usize| r.get(j).unwrap_or(first);
-            f([at(0), at(1), at(2), at(3)], (1 << r.len()) - 1)?;
+            f([at(0), at(1), at(2), at(3)], (1 << r.len()) - 1);
         }
-        ControlFlow::Continue(())
     }
 }
 
@@ -332,6 +330,15 @@ impl<T> LinearOctree<T> {
         }
     }
 
+    /// Clears the slots of `slots` from every octant mask of leaf `leaf`.
+    /// O(1).
+    #[inline]
+    pub(super) fn unmark_slots(&mut self, leaf: u32, slots: u64) {
+        for m in &mut self.octants[leaf as usize] {
+            *m &= !slots;
+        }
+    }
+
     /// Rebuilds leaf `leaf`'s octant masks from its items' keys. O(items).
     pub(super) fn remark_octants(&mut self, leaf: u32) {
         let n = &self.nodes[leaf];
@@ -339,7 +346,7 @@ impl<T> LinearOctree<T> {
         let mut octants = [0u64; 8];
         for (slot, it) in n.items.iter().take(64).enumerate() {
             if let Some(k) = octant_of(self.obj(it.handle).key, d) {
-                octants[k] |= 1 << slot;
+                octants[k] |= bit(slot);
             }
         }
         self.octants[leaf as usize] = octants;
@@ -369,11 +376,9 @@ impl<T> LinearOctree<T> {
         let item = n.items.swap_remove(slot as usize);
         // The slot and the last one leave their masks; the item moved from
         // the last slot (if any) is marked at its new one.
-        let gone = bit(slot as usize) | bit(last);
-        for m in &mut self.octants[leaf as usize] {
-            *m &= !gone;
-        }
-        if let Some(moved) = n.items.get(slot as usize).map(|m| m.handle) {
+        let moved = n.items.get(slot as usize).map(|m| m.handle);
+        self.unmark_slots(leaf, bit(slot as usize) | bit(last));
+        if let Some(moved) = moved {
             let o = self.obj_mut(moved);
             o.slot = slot;
             let key = o.key;

@@ -9,14 +9,20 @@ use super::LinearOctree;
 use crate::broad::walk::{Cast, Contact};
 use crate::broad::{Filter, RayHit};
 use crate::geom::overlap::EntryBound;
-use std::ops::ControlFlow;
 
 /// A subtree is skipped only when its box entry `t0` exceeds the best hit by more
 /// than this relative margin: the box and sphere entry parameters are rounded
 /// differently (and the loose box is checked to contain the sphere's rounded
 /// box, not the exact ball), and a pruned subtree must never hold the true
-/// first hit.
+/// first hit. The same bound limits the leaf octants scanned.
 const PRUNE_MARGIN: f32 = 1e-4;
+
+/// What a box or octant must be entered after to be skipped, given the best
+/// hit's time `t` (see [`PRUNE_MARGIN`]).
+#[inline(always)]
+fn prune_bound(t: f32) -> f32 {
+    t + PRUNE_MARGIN * (t.abs() + 1.0)
+}
 
 impl<T> LinearOctree<T> {
     /// The contact of a ray or sweep with the smallest `(t, handle)`; the
@@ -25,9 +31,11 @@ impl<T> LinearOctree<T> {
     /// [`EntryBound::enter_octants`], no child read before it is entered)
     /// are visited front to back in the octant order of the cast's
     /// direction ([`EntryBound::near_octant`]), each skipped if entered after
-    /// the best hit so far. A leaf's spheres take the cast's four-wide
-    /// pre-test ([`Contact::misses4`]) where it has one (sweeps), and those
-    /// it leaves in go straight to the exact test
+    /// the best hit so far. A leaf scans only the items of the octants of
+    /// its cell that the cast's box up to that bound reaches
+    /// ([`EntryBound::reach_octants`], `LinearOctree::octants`); they take
+    /// the cast's four-wide pre-test ([`Contact::misses4`]) where it has one
+    /// (sweeps), and those it leaves in go straight to the exact test
     /// ([`Contact::contact_after_misses4`]). No
     /// allocation (≤ 8 children listed on the stack per level). Objects
     /// whose filter does not interact with `filter` are skipped at the
@@ -65,7 +73,7 @@ impl<T> LinearOctree<T> {
         if let Some(b) = best {
             // `t0` unrounded (`EntryBound::enter_octants`): above an `f32`
             // bound, the box's exact entry is too.
-            if t0 > (b.t + PRUNE_MARGIN * (b.t.abs() + 1.0)) as f64 {
+            if t0 > prune_bound(b.t) as f64 {
                 return;
             }
         }
@@ -88,7 +96,7 @@ impl<T> LinearOctree<T> {
             // instructions, 66 -> 45 L1 data misses and 72 -> 65
             // mispredicted branches a sweep).
             let reach = if d < MAX_DEPTH {
-                let limit = best.map_or(f32::INFINITY, |b| b.t + PRUNE_MARGIN * (b.t.abs() + 1.0));
+                let limit = best.map_or(f32::INFINITY, |b| prune_bound(b.t));
                 entry.reach_octants(self.child_halves(n, c, d), limit)
             } else {
                 0xFF
@@ -98,7 +106,7 @@ impl<T> LinearOctree<T> {
             // (callgrind, `w8 --n 100000 --queries 5000 --reps 1 --check 0
             // --only LinearOctree`: 16.2k -> 12.5k instructions a first-hit
             // sweep, before the octant masks).
-            let _ = n.for_each_quad::<()>(&self.octants[i as usize], d, reach, |q, valid| {
+            n.for_each_quad(&self.octants[i as usize], d, reach, |q, valid| {
                 if X::HAS_MISSES4 {
                     let spheres = [&q[0].sphere, &q[1].sphere, &q[2].sphere, &q[3].sphere];
                     let mut lanes = !test.misses4(spheres) & valid;
@@ -117,7 +125,6 @@ impl<T> LinearOctree<T> {
                         lanes &= lanes - 1;
                     }
                 }
-                ControlFlow::Continue(())
             });
             return;
         }

@@ -644,8 +644,10 @@ fn nearest_over_a_full_leaf_of_duplicates_at_the_depth_cap() {
 /// remainder of 0-3 spheres both run, and the first hits' octant filter
 /// (`LinearOctree::octants`) on leaves of over 64 items (slots from 64 on are in
 /// no mask) and on leaves at the depth cap (no octants: four clusters of
-/// equal centres): random sweeps, zero-length ones, radius 0, grazes at the
-/// summed radii from a stored sphere, and an early stop.
+/// equal spheres, whose ties the first hit breaks by handle): random
+/// sweeps, zero-length ones, radius 0, grazes at the summed radii from a
+/// stored sphere, and an early stop; each non-empty sweep's segment also as
+/// a ray (first hit).
 #[test]
 fn sweeps_over_leaves_of_every_size_match_brute_force() {
     use crate::geom::{overlap, SphereSweep};
@@ -657,12 +659,12 @@ fn sweeps_over_leaves_of_every_size_match_brute_force() {
         let mut t = LinearOctree::with_config(cfg(leaf, leaf / 2, 21)).unwrap();
         let mut spheres = Vec::new();
         for i in 0..1500usize {
-            let c = if i % 100 < 3 {
-                twins[i % 4]
+            // Equal twins (centre and radius): ties, broken by handle.
+            let s = if i % 100 < 3 {
+                Sphere::new(twins[i / 100 % 4], 1.0)
             } else {
-                p(&mut rng)
+                Sphere::new(p(&mut rng), rng.gen_range(0.0..2.0))
             };
-            let s = Sphere::new(c, rng.gen_range(0.0..2.0));
             t.insert(s, i).unwrap();
             spheres.push(s);
         }
@@ -751,16 +753,27 @@ fn sweeps_over_leaves_of_every_size_match_brute_force() {
         };
         assert_eq!(flow, Ok(stopped), "early stop, {sw:?}");
         assert_eq!(seen, want.len().min(1), "early stop, {sw:?}");
-        let want_t = spheres
-            .iter()
-            .filter_map(|s| overlap::sweep_sphere(sw, s))
-            .min_by(f32::total_cmp);
-        let first = t.sweep_first(sw, None).unwrap();
-        assert_eq!(first.map(|h| h.t), want_t, "{sw:?}");
-        if let Some(h) = first {
-            let i = *t.get(h.handle).unwrap().1;
-            assert_eq!(overlap::sweep_sphere(sw, &spheres[i]), Some(h.t), "{sw:?}");
-            *firsts += 1;
+        // The smallest `(t, handle)`: handles ascend with the ids here.
+        let first_of =
+            |hit: Option<crate::broad::RayHit>| hit.map(|h| (h.t, *t.get(h.handle).unwrap().1));
+        let smallest = |tests: &mut dyn Iterator<Item = (f32, usize)>| {
+            tests.min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+        };
+        let want = smallest(
+            &mut (0..spheres.len())
+                .filter_map(|i| overlap::sweep_sphere(sw, &spheres[i]).map(|t| (t, i))),
+        );
+        assert_eq!(first_of(t.sweep_first(sw, None).unwrap()), want, "{sw:?}");
+        *firsts += want.is_some() as usize;
+        // The same segment as a ray (no four-lane pre-test: one item at a
+        // time through the octant filter).
+        if sw.from != sw.to {
+            let ray = crate::geom::Ray::with_max_t(sw.from, sw.to - sw.from, 1.0);
+            let want = smallest(
+                &mut (0..spheres.len())
+                    .filter_map(|i| overlap::ray_sphere(&ray, &spheres[i]).map(|t| (t, i))),
+            );
+            assert_eq!(first_of(t.ray_first(&ray, None).unwrap()), want, "{ray:?}");
         }
     }
 }

@@ -31,9 +31,7 @@ impl<T> LinearOctree<T> {
             item.ext = ext;
             // The centre may have crossed into another octant of the leaf.
             if octant_of(key, d) != octant_of(old_key, d) {
-                for m in &mut self.octants[s as usize] {
-                    *m &= !bit(slot as usize);
-                }
+                self.unmark_slots(s, bit(slot as usize));
                 self.mark_octant(s, slot, key);
             }
             if ext > old_ext {

@@ -121,6 +121,10 @@ impl<T> LinearOctree<T> {
                 ));
             }
             let loose = self.loose_of(c, d, n.max_extent);
+            // First-hit scans take only the slots of the octants a cast
+            // reaches, judged by the octants' loose boxes (`child_halves`).
+            let halves = (d < MAX_DEPTH).then(|| self.child_halves(n, c, d));
+            let mut octants = [0u64; 8];
             for (slot, it) in n.items.iter().enumerate() {
                 let Ok(o) = self.objects.get(it.handle) else {
                     return fail(format!("leaf {:?} holds a dead handle", n.code));
@@ -156,27 +160,21 @@ impl<T> LinearOctree<T> {
                         o.sphere, n.code
                     ));
                 }
-                sub.max_ext = sub.max_ext.max(it.ext);
-            }
-            // Leaf scans take only the slots of the octants a query reaches,
-            // judged by the octants' loose boxes (`child_halves`).
-            let mut octants = [0u64; 8];
-            for (slot, it) in n.items.iter().enumerate() {
-                if let Some(k) = octant_of(self.obj(it.handle).key, d) {
+                if let (Some(k), Some(h)) = (octant_of(o.key, d), halves) {
                     octants[k] |= bit(slot);
-                    let h = self.child_halves(n, c, d);
-                    let (lo, hi) = (it.sphere.aabb().min, it.sphere.aabb().max);
+                    let b = o.sphere.aabb();
                     let inside = (0..3).all(|a| {
                         let (l, u) = h[a][(k >> a) & 1];
-                        le(l, lo[a]) && le(hi[a], u)
+                        le(l, b.min[a]) && le(b.max[a], u)
                     });
                     if !inside {
                         return fail(format!(
                             "sphere {:?} outside the loose box of its octant {k} of {:?}",
-                            it.sphere, n.code
+                            o.sphere, n.code
                         ));
                     }
                 }
+                sub.max_ext = sub.max_ext.max(it.ext);
             }
             if octants != self.octants[i as usize] {
                 return fail(format!("octant masks of leaf {:?} are wrong", n.code));

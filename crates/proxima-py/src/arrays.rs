@@ -65,13 +65,19 @@ pub fn f32_values(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<usize>, V
     // numpy's default float64, C order (a pose, a row of points): rounded
     // here as numpy's cast would (to nearest), without the `asarray` call and
     // the temporary array that cost a one-pose `collide` ~0.8 µs (perf).
+    // Read in place (a borrow, not `to_vec`'s copy: 100k points were a
+    // 2.4 MB temporary, its page faults and a `memmove`); an array borrowed
+    // mutably elsewhere or not aligned takes the copying path below.
     if let Ok(x) = a.cast::<PyArrayDyn<f64>>() {
         if x.is_c_contiguous() {
-            let values = x.to_vec().map_err(err)?;
-            return Ok((
-                x.shape().to_vec(),
-                values.iter().map(|&v| v as f32).collect(),
-            ));
+            if let Ok(r) = x.try_readonly() {
+                if let Ok(values) = r.as_slice() {
+                    return Ok((
+                        x.shape().to_vec(),
+                        values.iter().map(|&v| v as f32).collect(),
+                    ));
+                }
+            }
         }
     }
     let a = match a.cast::<PyArrayDyn<f32>>() {

@@ -394,40 +394,61 @@ impl<'a> KBest<'a> {
             return 0;
         }
         let mut taken = 0;
-        let kth = if self.k <= LINEAR_MAX_K {
+        // Each value carries its index in its 6 lowest bits (`SEED_MAX` =
+        // 64; non-negative finite values order as their bits, so the keys
+        // order by the value, to 64 ulps, then the index), and the bound is
+        // the largest exact value of the `k` taken: `k` values lie at or
+        // below it. The bits are also raised by one exponent step, which
+        // keeps their order and keeps a 0 (a point on the query) out of the
+        // subnormals: a host with denormals-are-zero on (a fast-math
+        // extension in the same Python process) would compare those keys
+        // equal, and the min/max could then take one index twice.
+        let key = |i: usize| f64::from_bits((s2[i].to_bits() & !63 | i as u64) + (1 << 52));
+        // The values are never NaN, so these are `min` and `max` and compile
+        // to one instruction each (`f64::min` handles NaN, and the `u64`
+        // bits have no SSE2 min: both cost several: 1.70k -> 1.01k
+        // instructions a query, callgrind on `examples/knn_leaf`, 100k
+        // points, k = 10).
+        let lo = |a: f64, b: f64| if a < b { a } else { b };
+        let hi = |a: f64, b: f64| if a > b { a } else { b };
+        let kth = if self.k == 1 {
+            // The smallest key, in four running minima: one was a chain of
+            // dependent `min`s, ~4 cycles a value (`perf`: the Python batch
+            // at k = 1 spent ~9% of its time here). The last 1-4 values go
+            // as a four with the last one repeated (a repeated key changes
+            // no minimum), so the loop's length is the leaf's quads.
+            let n = s2.len();
+            let mut m = [f64::INFINITY; 4];
+            let mut from = 0;
+            while from + 4 < n {
+                for (j, mj) in m.iter_mut().enumerate() {
+                    *mj = lo(*mj, key(from + j));
+                }
+                from += 4;
+            }
+            for (j, mj) in m.iter_mut().enumerate() {
+                *mj = lo(*mj, key((from + j).min(n - 1)));
+            }
+            let x = lo(lo(m[0], m[1]), lo(m[2], m[3]));
+            first[0] = (x.to_bits() & 63) as u8;
+            taken = 1;
+            s2[first[0] as usize]
+        } else if self.k <= LINEAR_MAX_K {
             // The k smallest kept sorted (`∞` for "none yet"): cheaper than
             // the library's selection on a leaf's few dozen values
             // (callgrind: ~750 instructions a call there). An entering value
             // moves in by a min/max per slot, without a branch: where it
             // stops is unpredictable, and the shifting loop it replaces
             // mispredicted ~18 times a query (callgrind, W7 points k = 10).
-            // The values are never NaN, so the plain comparisons below are
-            // `min` and `max` and compile to one instruction each (`f64::min`
-            // handles NaN, and the `u64` bits have no SSE2 min: both cost
-            // several: 1.70k -> 1.01k instructions a query, callgrind on
-            // `examples/knn_leaf`, 100k points, k = 10).
-            let lo = |a: f64, b: f64| if a < b { a } else { b };
-            let hi = |a: f64, b: f64| if a > b { a } else { b };
-            // Each value carries its index in its 6 lowest bits (`SEED_MAX`
-            // = 64; non-negative finite values order as their bits, so the
-            // network orders the keys by the value, to 64 ulps, then the
-            // index), and the bound is the largest exact value of the `k`
-            // taken: `k` values lie at or below it. The bits are also
-            // raised by one exponent step, which keeps their order and
-            // keeps a 0 (a point on the query) out of the subnormals: a
-            // host with denormals-are-zero on (a fast-math extension in
-            // the same Python process) would compare those keys equal, and
-            // the min/max could then take one index twice.
             let mut top = [f64::INFINITY; LINEAR_MAX_K];
             let k = self.k;
-            for (i, &v) in s2.iter().enumerate() {
-                let x = f64::from_bits((v.to_bits() & !63 | i as u64) + (1 << 52));
+            for i in 0..s2.len() {
+                let x = key(i);
                 // For small `k` every value goes through the network, which
                 // leaves the `k` as they were when it does not enter: cheaper
                 // than the test, whose outcome is unpredictable while the
-                // `k` are still falling (at k = 1, ~4.5 of 48 values enter,
-                // and the test mispredicted ~4.4 times a query; callgrind,
-                // `knn_leaf 100000 1 4000 48`).
+                // `k` are still falling (k = 4: 36 -> 31 mispredicts a
+                // query, callgrind, `knn_leaf 100000 4 4000 48`).
                 if k > BRANCH_FREE_MAX_K && x >= top[k - 1] {
                     continue;
                 }

@@ -297,11 +297,15 @@ pub fn nearest(
                 })
         });
     } else {
-        // Each query is built as its turn comes (no batch of them to
-        // allocate) and validated by `nearest_into` itself.
+        // The points gathered in Morton order first: read at each query's
+        // turn, each was a cache miss the search waited on (~7% of a k = 1
+        // batch's time, `perf`); gathered in one loop the misses overlap.
+        // Each query is built as its turn comes and validated by
+        // `nearest_into` itself.
+        let sorted: Vec<proxima::glam::Vec3> = order.iter().map(|&i| points[i as usize]).collect();
         let (mut buf, mut scratch) = (Vec::new(), Vec::new());
-        for &i in &order {
-            let q = query(points[i as usize]);
+        for (&i, &p) in order.iter().zip(&sorted) {
+            let q = query(p);
             index.nearest_into(&q, filter, &mut buf)?;
             let row = i as usize * k..(i as usize + 1) * k;
             fill(

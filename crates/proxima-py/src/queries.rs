@@ -183,6 +183,11 @@ fn first_each<Q: Sync>(
     hits.into_iter().unzip()
 }
 
+/// How many bytes of rows (12 an entry: an `f32` distance and an `i64` id)
+/// a one-worker `nearest` batch stages at a time: few enough to stay in a
+/// core's L2 cache (4096 rows at k = 10), and at least 16 rows.
+const STAGED_BYTES: usize = 480 * 1024;
+
 /// The answers of a batch of k-nearest queries as `(M, k)` row-major arrays:
 /// distances (`inf` where fewer than `k` were found) and ids (`-1` there).
 pub struct KnnTable {
@@ -272,12 +277,12 @@ pub fn nearest(
         d[j..].fill(f32::INFINITY);
         ids[j..].fill(-1);
     };
-    // Row i of the answer is query `rank[i]` of the batch.
-    let mut rank = vec![0u32; m];
-    for (j, &i) in order.iter().enumerate() {
-        rank[i as usize] = j as u32;
-    }
     if workers.parallel() {
+        // Row i of the answer is query `rank[i]` of the batch.
+        let mut rank = vec![0u32; m];
+        for (j, &i) in order.iter().enumerate() {
+            rank[i as usize] = j as u32;
+        }
         let queries: Vec<Nearest> = order.iter().map(|&i| query(points[i as usize])).collect();
         let batch = workers.run(|| par_nearest(index, &queries, filter))?;
         // Zeroed memory (fresh pages, not written twice): `fill` writes every
@@ -298,39 +303,45 @@ pub fn nearest(
         });
         Ok(out)
     } else {
-        // The points gathered in Morton order first: read at each query's
-        // turn, each was a cache miss the search waited on (~7% of a k = 1
-        // batch's time, `perf`); gathered in one loop the misses overlap.
-        // Each query is built as its turn comes and validated by
-        // `nearest_into` itself.
-        let sorted: Vec<proxima::glam::Vec3> = order.iter().map(|&i| points[i as usize]).collect();
-        // The rows in the searches' order, written one after another, then
-        // gathered into the caller's order: written in place, each row was
-        // a store to a random place of the answer that missed the cache
-        // (`perf`: ~9% of a k = 10 batch in the loop that wrote them).
-        let mut staged = KnnTable {
+        // Zeroed memory (fresh pages, not written twice): every row is
+        // written whole once.
+        let mut out = KnnTable {
             distances: vec![0.0; m * k],
             ids: vec![0; m * k],
         };
-        let (mut buf, mut scratch) = (Vec::new(), Vec::new());
-        let rows = staged
-            .distances
-            .chunks_exact_mut(k)
-            .zip(staged.ids.chunks_exact_mut(k));
-        for (&p, (d, ids)) in sorted.iter().zip(rows) {
-            let q = query(p);
-            index.nearest_into(&q, filter, &mut buf)?;
-            fill(&q, &buf, &mut scratch, d, ids);
-        }
-        let mut out = KnnTable {
-            distances: Vec::with_capacity(m * k),
-            ids: Vec::with_capacity(m * k),
+        // In blocks of the Morton order: the block's points gathered first
+        // (read at each query's turn, each was a cache miss the search
+        // waited on, ~7% of a k = 1 batch, `perf`; in one loop the misses
+        // overlap), its rows written one after another into a small table
+        // that stays in cache, then copied to their places in the answer.
+        // Written in place at each query's turn, a row was a store to a
+        // random place of the answer that missed the cache (~9% of a k = 10
+        // batch, `perf`). Each query is built as its turn comes and
+        // validated by `nearest_into` itself.
+        let block = (STAGED_BYTES / (12 * k)).max(16).min(m);
+        let mut points_at = Vec::with_capacity(block);
+        let mut staged = KnnTable {
+            distances: vec![0.0; block * k],
+            ids: vec![0; block * k],
         };
-        for &j in &rank {
-            let row = j as usize * k..(j as usize + 1) * k;
-            out.distances
-                .extend_from_slice(&staged.distances[row.clone()]);
-            out.ids.extend_from_slice(&staged.ids[row]);
+        let (mut buf, mut scratch) = (Vec::new(), Vec::new());
+        for rows in order.chunks(block) {
+            points_at.clear();
+            points_at.extend(rows.iter().map(|&i| points[i as usize]));
+            let at = staged
+                .distances
+                .chunks_exact_mut(k)
+                .zip(staged.ids.chunks_exact_mut(k));
+            for (&p, (d, ids)) in points_at.iter().zip(at) {
+                let q = query(p);
+                index.nearest_into(&q, filter, &mut buf)?;
+                fill(&q, &buf, &mut scratch, d, ids);
+            }
+            for (j, &i) in rows.iter().enumerate() {
+                let (from, to) = (j * k..(j + 1) * k, i as usize * k..(i as usize + 1) * k);
+                out.distances[to.clone()].copy_from_slice(&staged.distances[from.clone()]);
+                out.ids[to].copy_from_slice(&staged.ids[from]);
+            }
         }
         Ok(out)
     }

@@ -8,7 +8,7 @@ use numpy::{PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArrayMetho
 use proxima::broad::Filter;
 use proxima::geom::{Aabb, Frustum, Ray};
 use proxima::glam::{Affine3A, Mat3A, Mat4, Vec3, Vec3A, Vec4};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 
@@ -185,6 +185,27 @@ pub fn int_list(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<i64>> {
         [] | [_] => Ok(v),
         _ => Err(shape_error(what, "(N,)", &shape)),
     }
+}
+
+/// Whether an answer of `rows` rows of `cols` entries, `bytes` bytes an
+/// entry, can be allocated: `MemoryError` naming `what` if its size
+/// overflows or the allocator refuses it (as numpy's own arrays would), so
+/// that the allocation that follows cannot abort the interpreter (Rust's
+/// infallible allocation aborts on failure). A probe: reserved and released
+/// at once, never written, so it costs no page of memory.
+pub fn check_answer_size(what: &str, rows: usize, cols: usize, bytes: usize) -> PyResult<()> {
+    let too_large = || {
+        PyMemoryError::new_err(format!(
+            "{what}: an answer of {rows} x {cols} entries does not fit in memory"
+        ))
+    };
+    let n = rows
+        .checked_mul(cols)
+        .and_then(|n| n.checked_mul(bytes))
+        .ok_or_else(too_large)?;
+    Vec::<u8>::new()
+        .try_reserve_exact(n)
+        .map_err(|_| too_large())
 }
 
 /// The `ValueError` for an array of the wrong shape.

@@ -555,7 +555,8 @@ impl Index {
     /// search, about O(log n + k log k); runs with the interpreter released.
     ///
     /// Raises ValueError on a wrong shape, a non-finite point, k < 1, a NaN
-    /// or negative bound or an unknown metric.
+    /// or negative bound or an unknown metric, and MemoryError when the
+    /// (M, k) answer cannot be allocated (a huge k).
     #[pyo3(signature = (points, k=1, *, distance_upper_bound=f64::INFINITY, metric="surface", filter=None, workers=1))]
     #[allow(clippy::too_many_arguments)]
     fn nearest<'py>(
@@ -599,6 +600,8 @@ impl Index {
         let bound = round_up_f32(distance_upper_bound);
         let filter = query_filter(filter)?;
         let workers = Workers::new(workers)?;
+        // Each entry an f32 distance and an i64 id.
+        arrays::check_answer_size("nearest", m, k, 12)?;
         let pts: Vec<_> = v.chunks_exact(3).map(vec3).collect();
         let (inner, ordered, by_slot) = (&self.inner, self.ids.ordered(), self.ids.id_of_slot());
         let table = py

@@ -392,6 +392,9 @@ def idx(rng):
         (lambda i: i.nearest([[0, 0, 0]], filter=(1, -1)), ValueError, "mask"),
         (lambda i: i.nearest([[0, 0, 0]], filter="all"), ValueError, "filter"),
         (lambda i: i.nearest([[0, 0, 0]], workers=0), ValueError, "workers"),
+        # An answer too large to allocate: a Python error, not an abort.
+        (lambda i: i.nearest([[0, 0, 0]], 2**62), MemoryError, "does not fit in memory"),
+        (lambda i: i.nearest(np.zeros((4, 3)), 2**40), MemoryError, "4 x 1099511627776"),
         (lambda i: i.sweep([[0, 0, 0]], [[1, 1, 1], [2, 2, 2]]), ValueError, "1 starts but 2 ends"),
         (lambda i: i.sweep([[0, 0, 0]], [[1, 1]]), ValueError, "ends"),
         (lambda i: i.sweep([[0, 0, np.nan]], [[1, 1, 1]]), ValueError, "starts: row 0"),

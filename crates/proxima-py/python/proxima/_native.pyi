@@ -256,7 +256,8 @@ class Index:
         kind gives the same answer bit for bit. Releases the GIL.
 
         Raises ValueError on a wrong shape, a non-finite point, k < 1, a NaN
-        or negative bound or an unknown metric; TypeError on a non-integer k.
+        or negative bound or an unknown metric; TypeError on a non-integer k;
+        MemoryError when the (M, k) answer cannot be allocated (a huge k).
         """
 
     @overload

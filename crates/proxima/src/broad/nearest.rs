@@ -268,6 +268,66 @@ pub(crate) struct KBest<'a> {
     synced: f32,
 }
 
+/// The smaller of two keys of [`KBest::tighten_by_centres`]. The keys are
+/// never NaN, so these plain comparisons are `min` and `max` and compile to
+/// one instruction each (`f64::min` handles NaN, and the `u64` bits have no
+/// SSE2 min: both cost several: 1.70k -> 1.01k instructions a query,
+/// callgrind on `examples/knn_leaf`, 100k points, k = 10).
+#[inline(always)]
+fn lo(a: f64, b: f64) -> f64 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// The larger of two keys; see [`lo`].
+#[inline(always)]
+fn hi(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// Inserts `x` into `top` (ascending; `∞` for "none yet"), dropping the
+/// largest: slot j keeps the smaller of its value and the larger of its
+/// lower neighbour's and x, from the top down, without a branch (where x
+/// stops is unpredictable). O(len).
+#[inline(always)]
+fn insert_key(top: &mut [f64], x: f64) {
+    for j in (1..top.len()).rev() {
+        top[j] = lo(top[j], hi(top[j - 1], x));
+    }
+    top[0] = lo(top[0], x);
+}
+
+/// The `K` smallest of `key(0..n)`, ascending, into `top[..K]`: the
+/// insertion network of [`insert_key`] on a `K` known at compile time, so
+/// that it is unrolled and its slots stay in registers. For `K` up to
+/// [`BRANCH_FREE_MAX_K`] every key goes through it (it leaves the `K` as
+/// they were when the key does not enter): cheaper than the test, whose
+/// outcome is unpredictable while the `K` are still falling (k = 4: 36 ->
+/// 31 mispredicts a query, callgrind, `knn_leaf 100000 4 4000 48`).
+#[inline(always)]
+fn smallest_keys<const K: usize>(
+    n: usize,
+    key: impl Fn(usize) -> f64,
+    top: &mut [f64; LINEAR_MAX_K],
+) {
+    let mut t = [f64::INFINITY; K];
+    for i in 0..n {
+        let x = key(i);
+        if K > BRANCH_FREE_MAX_K && x >= t[K - 1] {
+            continue;
+        }
+        insert_key(&mut t, x);
+    }
+    top[..K].copy_from_slice(&t);
+}
+
 impl<'a> KBest<'a> {
     /// An empty set in `out` (cleared) for the `k` best within `limit`.
     pub(crate) fn new(out: &'a mut Vec<Neighbor>, k: usize, limit: f32) -> Self {
@@ -404,13 +464,6 @@ impl<'a> KBest<'a> {
         // extension in the same Python process) would compare those keys
         // equal, and the min/max could then take one index twice.
         let key = |i: usize| f64::from_bits((s2[i].to_bits() & !63 | i as u64) + (1 << 52));
-        // The values are never NaN, so these are `min` and `max` and compile
-        // to one instruction each (`f64::min` handles NaN, and the `u64`
-        // bits have no SSE2 min: both cost several: 1.70k -> 1.01k
-        // instructions a query, callgrind on `examples/knn_leaf`, 100k
-        // points, k = 10).
-        let lo = |a: f64, b: f64| if a < b { a } else { b };
-        let hi = |a: f64, b: f64| if a > b { a } else { b };
         let kth = if self.k == 1 {
             // The smallest key, in four running minima: one was a chain of
             // dependent `min`s, ~4 cycles a value (`perf`: the Python batch
@@ -442,23 +495,30 @@ impl<'a> KBest<'a> {
             // mispredicted ~18 times a query (callgrind, W7 points k = 10).
             let mut top = [f64::INFINITY; LINEAR_MAX_K];
             let k = self.k;
-            for i in 0..s2.len() {
-                let x = key(i);
-                // For small `k` every value goes through the network, which
-                // leaves the `k` as they were when it does not enter: cheaper
-                // than the test, whose outcome is unpredictable while the
-                // `k` are still falling (k = 4: 36 -> 31 mispredicts a
-                // query, callgrind, `knn_leaf 100000 4 4000 48`).
-                if k > BRANCH_FREE_MAX_K && x >= top[k - 1] {
-                    continue;
-                }
-                // Slot j keeps the smaller of its value and the larger of
-                // its lower neighbour's and x: the insertion, from the top.
-                for j in (1..k).rev() {
-                    top[j] = lo(top[j], hi(top[j - 1], x));
-                }
-                top[0] = lo(top[0], x);
+            let n = s2.len();
+            // Up to 16, one copy per `k`, whose `k` smallest stay in
+            // registers: held in memory, the network's two-lane loads of
+            // neighbouring slots straddled the stores of the value before
+            // (store-to-load forwarding failed: `perf` put a quarter of the
+            // function's time on one such load, Python batch at k = 10).
+            // `knn_leaf 100000 K 30000 48`: k = 10 and 16 -7%, k = 4 equal;
+            // copies up to 32 gained ~3% at k = 20 and nothing at 32.
+            macro_rules! by_k {
+                ($($c:literal)*) => {
+                    match k {
+                        $($c => smallest_keys::<$c>(n, key, &mut top),)*
+                        _ => {
+                            for i in 0..n {
+                                let x = key(i);
+                                if x < top[k - 1] {
+                                    insert_key(&mut top[..k], x);
+                                }
+                            }
+                        }
+                    }
+                };
             }
+            by_k!(2 3 4 5 6 7 8 9 10 11 12 13 14 15 16);
             let mut kth = 0.0f64;
             for (f, t) in first.iter_mut().zip(&top[..k]) {
                 *f = (t.to_bits() & 63) as u8;
@@ -1120,7 +1180,7 @@ mod tests {
                 .map(|&c| overlap::point_sphere_distance(p, &Sphere::new(c, 0.0)))
                 .collect();
             exact.sort_unstable_by(f32::total_cmp);
-            let k = [1, 2, 5, 10, LINEAR_MAX_K, LINEAR_MAX_K + 1, 40][round % 7];
+            let k = [1, 2, 5, 10, 16, 17, LINEAR_MAX_K, LINEAR_MAX_K + 1, 40][round % 9];
             let limit = if round % 11 == 0 { 0.0 } else { f32::INFINITY };
             let s2: Vec<f64> = centres
                 .iter()

@@ -225,8 +225,9 @@ pub(crate) const SORTED_MAX_K: usize = 256;
 /// (`O(k)` comparisons, no call); above it by a binary search and a move.
 pub(crate) const LINEAR_MAX_K: usize = 32;
 
-/// Up to this `k`, [`KBest::tighten_by_centres`] passes every value through
-/// its insertion network, without first testing whether it enters.
+/// From `k = 2` up to this `k`, [`KBest::tighten_by_centres`] passes every
+/// value through its insertion network, without first testing whether it
+/// enters (`k = 1` takes running minima).
 const BRANCH_FREE_MAX_K: usize = 4;
 
 /// The largest group [`KBest::tighten_by_centres`] takes (the octree's first
@@ -501,8 +502,9 @@ impl<'a> KBest<'a> {
             // neighbouring slots straddled the stores of the value before
             // (store-to-load forwarding failed: `perf` put a quarter of the
             // function's time on one such load, Python batch at k = 10).
-            // `knn_leaf 100000 K 30000 48`: k = 10 and 16 -7%, k = 4 equal;
-            // copies up to 32 gained ~3% at k = 20 and nothing at 32.
+            // `knn_leaf 100000 K 50000 48` (30000 queries for k = 4, 16, 20
+            // and 32): k = 10 and 16 -7%, k = 4 equal; copies up to 32
+            // gained ~3% at k = 20 and nothing at 32.
             macro_rules! by_k {
                 ($($c:literal)*) => {
                     match k {

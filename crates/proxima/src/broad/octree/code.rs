@@ -95,20 +95,27 @@ pub(crate) fn dilate(v: u32) -> u64 {
     x
 }
 
-/// The depth of the cells [`morton_order`] sorts by: a `2^10` grid per axis,
-/// a billion cells, far finer than any batch needs for its neighbouring
-/// queries to share nodes, and few enough bits that a key and its index fit
-/// one `u64`.
-const ORDER_DEPTH: u32 = 10;
+/// The depth of the cells [`morton_order`] sorts `m` points by, and the bits
+/// of an index below `m`: as many levels of the placement key as fit one
+/// `u64` beside the index (15 levels for 100k points, 14 for 1M, 19 for up
+/// to 128), so that a plain integer sort orders by cell, then index. Deep
+/// enough that a far outlier, which widens the box, still leaves the other
+/// points in small cells. O(1).
+fn order_depth(m: usize) -> (u32, u32) {
+    let index_bits = usize::BITS - m.saturating_sub(1).leading_zeros();
+    (((64 - index_bits) / 3).min(MAX_DEPTH), index_bits)
+}
 
 /// The indices of `points` sorted along the Morton (Z-order) curve over the
-/// cube spanned by the points' bounding box, on a `2^10` grid per axis (the
-/// first 10 levels of the octree's own placement key of each point; ties by
-/// index): a batch of queries run in this order visits the same nodes and
-/// objects one query after another, so they stay in cache [sources:
-/// octree-code]. Non-finite coordinates are allowed (the batch checks them
-/// itself): they get some key, never a panic. Cost: O(m log m) for `m`
-/// points, one allocation besides the answer.
+/// cube spanned by the points' bounding box (ties by index): a batch of
+/// queries run in this order visits the same nodes and objects one query
+/// after another, so they stay in cache [sources: octree-code]. The curve
+/// is followed down to cells of the octree's own placement key as deep as
+/// fit one `u64` beside the index (a `2^15` grid per axis for 100k points,
+/// `2^14` for 1M). Non-finite coordinates are
+/// allowed (the batch checks them itself): they get some key, never a
+/// panic. Indices are `u32`: for at most `2^32` points. Cost: O(m log m)
+/// for `m` points, one allocation besides the answer.
 pub fn morton_order(points: &[Vec3]) -> Vec<u32> {
     let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
     for p in points.iter().filter(|p| p.is_finite()) {
@@ -128,15 +135,18 @@ pub fn morton_order(points: &[Vec3]) -> Vec<u32> {
     // sort orders by cell, then index. 100k random points: 3.1 ms a call
     // with the full 63-bit key in a `u128` beside the index, 2.2 ms so
     // (4.2-4.4 ms as `(u64, u32)` tuples with `floorf` in the key).
-    let cut = 3 * (MAX_DEPTH - ORDER_DEPTH);
+    let (depth, index_bits) = order_depth(points.len());
+    let cut = 3 * (MAX_DEPTH - depth);
+    let cells = (1u64 << (3 * depth)) - 1;
     let mut keyed: Vec<u64> = (points.iter().enumerate())
         .map(|(i, &p)| {
-            let cell = (point_key(lo, max, scale, p) >> cut) & ((1 << (3 * ORDER_DEPTH)) - 1);
-            cell << 32 | i as u64
+            let cell = (point_key(lo, max, scale, p) >> cut) & cells;
+            cell << index_bits | i as u64
         })
         .collect();
     keyed.sort_unstable();
-    keyed.into_iter().map(|k| k as u32).collect()
+    let index = (1u64 << index_bits) - 1;
+    keyed.into_iter().map(|k| (k & index) as u32).collect()
 }
 
 /// Inverse of [`dilate`]: gathers every third bit (from bit 0) into the low 21 bits.
@@ -350,11 +360,11 @@ impl LocationCode {
 #[inline]
 pub(crate) fn point_key(min: Vec3, max: Vec3, scale: Vec3, p: Vec3) -> u64 {
     let top = ((1u32 << MAX_DEPTH) - 1) as f32;
-    // Never negative (`p` is clamped to `min` first, and `scale >= 0`), so
-    // the truncating casts are the floor, and `top` is a whole number: the
-    // same key as flooring first, without a `floorf` call per axis (no SSE4.1
-    // rounding in the baseline x86-64 target). A NaN clamps to 0 (`f32::max`
-    // takes the other operand), as it did.
+    // Clamped to `[0, top]` before the casts, and `top` is a whole number:
+    // on that range truncating is the floor, so the key is the one flooring
+    // first gave, without a `floorf` call per axis (no SSE4.1 rounding in the
+    // baseline x86-64 target). A NaN casts to 0 either way (`as u32`
+    // saturates).
     let q = ((p.clamp(min, max) - min) * scale).clamp(Vec3::ZERO, Vec3::splat(top));
     (1u64 << 63) | dilate(q.x as u32) | (dilate(q.y as u32) << 1) | (dilate(q.z as u32) << 2)
 }
@@ -426,7 +436,7 @@ mod tests {
         );
     }
 
-    /// On random points the order of the keys cut to `ORDER_DEPTH` levels,
+    /// On random points the order of the keys cut to `order_depth` levels,
     /// then the index, exactly: with duplicates, and with pairs of points in
     /// one cell whose full keys order them against their indices.
     #[test]
@@ -438,21 +448,40 @@ mod tests {
         pts.extend((0..5000).map(|_| vec3(rng.gen(), rng.gen::<f32>() * 3.0, -rng.gen::<f32>())));
         for j in 2..202 {
             let p = pts[j] * 0.9;
-            pts.push(p + Vec3::splat(1e-5));
+            pts.push(p + Vec3::splat(1e-6));
             pts.push(p);
-            pts.push(p + Vec3::splat(1e-5));
+            pts.push(p + Vec3::splat(1e-6));
         }
         let (lo, hi) = (vec3(0.0, 0.0, -1.0), vec3(3.0, 3.0, 2.0));
         let scale = Vec3::splat((((1u32 << MAX_DEPTH) - 1) as f64 / 3.0) as f32);
         let mut expect: Vec<(u64, u32)> = (pts.iter().enumerate())
             .map(|(i, &p)| {
                 let code = LocationCode(point_key(lo, hi, scale, p));
-                (code.ancestor(ORDER_DEPTH).0, i as u32)
+                (code.ancestor(order_depth(5602).0).0, i as u32)
             })
             .collect();
         expect.sort_unstable();
         let order = morton_order(&pts);
         assert_eq!(order, expect.iter().map(|e| e.1).collect::<Vec<_>>());
+    }
+
+    /// One point far from the rest widens the box; the others still follow
+    /// the curve (in cells of `1e4 / 2^17` here), not the input order: a
+    /// step from one to the next averages well below a random step (~0.66
+    /// in the unit cube).
+    #[test]
+    fn morton_order_survives_a_far_outlier() {
+        let mut rng = Pcg64::seed_from_u64(11);
+        let mut pts: Vec<Vec3> = (0..4096)
+            .map(|_| vec3(rng.gen(), rng.gen(), rng.gen()))
+            .collect();
+        pts.push(Vec3::splat(1e4));
+        let order: Vec<Vec3> = (morton_order(&pts).into_iter())
+            .map(|i| pts[i as usize])
+            .filter(|p| p.x < 2.0)
+            .collect();
+        let step = order.windows(2).map(|w| w[0].distance(w[1])).sum::<f32>() / 4095.0;
+        assert!(step < 0.15, "mean step {step}");
     }
 
     #[test]

@@ -15,11 +15,16 @@ use pyo3::sync::PyOnceLock;
 /// How far the last row of a 4×4 pose may be from `(0, 0, 0, 1)`.
 const AFFINE_ROW_TOLERANCE: f32 = 1e-5;
 
-/// `numpy.asarray(obj)` (a no-op for an array), any failure as a `ValueError`
-/// naming the argument.
+/// `numpy.asarray(obj)` (a no-op for an array; an aligned copy of a
+/// misaligned one), any failure as a `ValueError` naming the argument.
 fn as_ndarray<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyAny>> {
     let py = obj.py();
-    if obj.is_instance_of::<numpy::PyUntypedArray>() {
+    if let Ok(a) = obj.cast::<numpy::PyUntypedArray>() {
+        // A misaligned array (a buffer read at an odd offset) cannot be
+        // read as a slice: an aligned copy is (`ndarray.copy`).
+        if !a.is_aligned() {
+            return obj.call_method0("copy");
+        }
         return Ok(obj.clone());
     }
     asarray(py)?
@@ -51,6 +56,9 @@ fn asarray(py: Python<'_>) -> PyResult<&Bound<'_, PyAny>> {
         .map(|f| f.bind(py))
 }
 
+/// From this many values on, [`f32_values`] reads a float64 array in place.
+const IN_PLACE_MIN: usize = 1024;
+
 /// A numeric array of any real dtype (bool, integers, floats; not complex,
 /// object or strings) as its shape and its values rounded to `f32`, C order.
 pub fn f32_values(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<usize>, Vec<f32>)> {
@@ -65,19 +73,21 @@ pub fn f32_values(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(Vec<usize>, V
     // numpy's default float64, C order (a pose, a row of points): rounded
     // here as numpy's cast would (to nearest), without the `asarray` call and
     // the temporary array that cost a one-pose `collide` ~0.8 µs (perf).
-    // Read in place (a borrow, not `to_vec`'s copy: 100k points were a
-    // 2.4 MB temporary, its page faults and a `memmove`); an array borrowed
-    // mutably elsewhere or not aligned takes the copying path below.
+    // Large arrays are read in place (a borrow, not `to_vec`'s copy: 100k
+    // points were a 2.4 MB temporary, its page faults and a `memmove`); one
+    // borrowed mutably elsewhere is copied. Small ones (a pose, a point) are
+    // copied: the borrow's bookkeeping does not pay there.
     if let Ok(x) = a.cast::<PyArrayDyn<f64>>() {
         if x.is_c_contiguous() {
-            if let Ok(r) = x.try_readonly() {
-                if let Ok(values) = r.as_slice() {
-                    return Ok((
-                        x.shape().to_vec(),
-                        values.iter().map(|&v| v as f32).collect(),
-                    ));
+            let round = |values: &[f64]| values.iter().map(|&v| v as f32).collect();
+            if x.len() >= IN_PLACE_MIN {
+                if let Ok(r) = x.try_readonly() {
+                    if let Ok(values) = r.as_slice() {
+                        return Ok((x.shape().to_vec(), round(values)));
+                    }
                 }
             }
+            return Ok((x.shape().to_vec(), round(&x.to_vec().map_err(err)?)));
         }
     }
     let a = match a.cast::<PyArrayDyn<f32>>() {
@@ -189,10 +199,12 @@ pub fn int_list(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<i64>> {
 
 /// Whether an answer of `rows` rows of `cols` entries, `bytes` bytes an
 /// entry, can be allocated: `MemoryError` naming `what` if its size
-/// overflows or the allocator refuses it (as numpy's own arrays would), so
-/// that the allocation that follows cannot abort the interpreter (Rust's
+/// overflows or the allocator refuses it (as numpy's own arrays would),
+/// rather than let the answer's allocation abort the interpreter (Rust's
 /// infallible allocation aborts on failure). A probe: reserved and released
-/// at once, never written, so it costs no page of memory.
+/// at once, never written, so it costs no page of memory. It checks the
+/// answer only, not the smaller working tables beside it, and an allocator
+/// that overcommits may still grant what the machine cannot hold.
 pub fn check_answer_size(what: &str, rows: usize, cols: usize, bytes: usize) -> PyResult<()> {
     let too_large = || {
         PyMemoryError::new_err(format!(

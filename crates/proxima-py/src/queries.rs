@@ -184,8 +184,8 @@ fn first_each<Q: Sync>(
 }
 
 /// How many bytes of rows (12 an entry: an `f32` distance and an `i64` id)
-/// a one-worker `nearest` batch stages at a time: few enough to stay in a
-/// core's L2 cache (4096 rows at k = 10), and at least 16 rows.
+/// a one-worker `nearest` batch stages at a time: 4096 rows at k = 10, few
+/// enough to stay in the L2 cache of the machine measured (2 MiB a core).
 const STAGED_BYTES: usize = 480 * 1024;
 
 /// The answers of a batch of k-nearest queries as `(M, k)` row-major arrays:
@@ -316,18 +316,31 @@ pub fn nearest(
         // that stays in cache, then copied to their places in the answer.
         // Written in place at each query's turn, a row was a store to a
         // random place of the answer that missed the cache (~9% of a k = 10
-        // batch, `perf`). Each query is built as its turn comes and
-        // validated by `nearest_into` itself.
-        let block = (STAGED_BYTES / (12 * k)).max(16).min(m);
-        let mut points_at = Vec::with_capacity(block);
+        // batch, `perf`). When the whole answer fits the staging budget, or
+        // not even 16 rows do (a large k), the rows go straight to their
+        // places: no second table as large as the answer. Each query is
+        // built as its turn comes and validated by `nearest_into` itself.
+        let fits = STAGED_BYTES / (12 * k);
+        let block = if fits >= 16 && fits < m { fits } else { m };
         let mut staged = KnnTable {
-            distances: vec![0.0; block * k],
-            ids: vec![0; block * k],
+            distances: vec![0.0; if block < m { block * k } else { 0 }],
+            ids: vec![0; if block < m { block * k } else { 0 }],
         };
+        let mut points_at = Vec::with_capacity(block);
         let (mut buf, mut scratch) = (Vec::new(), Vec::new());
         for rows in order.chunks(block) {
             points_at.clear();
             points_at.extend(rows.iter().map(|&i| points[i as usize]));
+            if block == m {
+                for (&p, &i) in points_at.iter().zip(rows) {
+                    let q = query(p);
+                    index.nearest_into(&q, filter, &mut buf)?;
+                    let row = i as usize * k..(i as usize + 1) * k;
+                    let (d, ids) = (&mut out.distances[row.clone()], &mut out.ids[row]);
+                    fill(&q, &buf, &mut scratch, d, ids);
+                }
+                continue;
+            }
             let at = staged
                 .distances
                 .chunks_exact_mut(k)

@@ -394,7 +394,7 @@ def idx(rng):
         (lambda i: i.nearest([[0, 0, 0]], workers=0), ValueError, "workers"),
         # An answer too large to allocate: a Python error, not an abort.
         (lambda i: i.nearest([[0, 0, 0]], 2**62), MemoryError, "does not fit in memory"),
-        (lambda i: i.nearest(np.zeros((4, 3)), 2**40), MemoryError, "4 x 1099511627776"),
+        (lambda i: i.nearest(np.zeros((4, 3)), 2**59), MemoryError, "4 x 576460752303423488"),
         (lambda i: i.sweep([[0, 0, 0]], [[1, 1, 1], [2, 2, 2]]), ValueError, "1 starts but 2 ends"),
         (lambda i: i.sweep([[0, 0, 0]], [[1, 1]]), ValueError, "ends"),
         (lambda i: i.sweep([[0, 0, np.nan]], [[1, 1, 1]]), ValueError, "starts: row 0"),
@@ -412,6 +412,47 @@ def test_bad_inputs_raise(idx, call, exc, message):
         call(idx)
     assert (len(idx), idx.pairs().tolist()) == before
     idx.validate()
+
+
+def test_nearest_batches_over_many_blocks_and_large_k(rng):
+    """One worker stages rows a block at a time (4096 rows at k = 10, 204 at
+    k = 200) or, for a small batch or a large k, writes them in place: every
+    way, each row is the oracle's, and two workers agree."""
+    c, r = scene(rng, n=600)
+    idx = proxima.Index(c, r, kind="octree")
+    for m, k in [(9000, 10), (500, 200), (40, 3000), (10, 10), (5000, 1)]:
+        pts = rng.uniform(-10, 110, (m, 3))
+        d, ids = check_knn(idx, c, r, pts, k)
+        d2, ids2 = idx.nearest(pts, k, workers=2)
+        np.testing.assert_array_equal(d2.reshape(d.shape), d)
+        np.testing.assert_array_equal(ids2.reshape(ids.shape), ids)
+
+
+def test_read_only_and_misaligned_points(idx, rng):
+    """Points over 1024 values are read in place: a read-only array is read
+    as it is, a misaligned one (float64 or float32, large or small; these
+    were refused as "not contiguous or misaligned") through a copy; each
+    answers as a plain copy."""
+    pts = rng.uniform(0, 100, (2000, 3))
+    want = idx.nearest(pts.copy(), 3)
+    frozen = pts.copy()
+    frozen.flags.writeable = False
+
+    def misaligned(a):
+        raw = np.zeros(a.nbytes + 1, np.uint8)
+        odd = np.frombuffer(raw.data, dtype=a.dtype, count=a.size, offset=1).reshape(a.shape)
+        odd[:] = a
+        assert not odd.flags.aligned and odd.flags.c_contiguous
+        return odd
+
+    for got in (idx.nearest(frozen, 3), idx.nearest(misaligned(pts), 3)):
+        np.testing.assert_array_equal(got[0], want[0])
+        np.testing.assert_array_equal(got[1], want[1])
+    few = pts[:5]
+    want = idx.nearest(few.astype(np.float32), 3)
+    for got in (idx.nearest(misaligned(few), 3), idx.nearest(misaligned(few.astype(np.float32)), 3)):
+        np.testing.assert_array_equal(got[0], want[0])
+        np.testing.assert_array_equal(got[1], want[1])
 
 
 def test_non_contiguous_and_other_dtypes(idx, rng):

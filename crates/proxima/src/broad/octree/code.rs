@@ -668,7 +668,7 @@ mod tests {
         let specials = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -0.0];
         for round in 0..200_000 {
             let m = 10f32.powi(rng.gen_range(-40..38));
-            let mut u = |rng: &mut Pcg64| match rng.gen_range(0..40) {
+            let u = |rng: &mut Pcg64| match rng.gen_range(0..40) {
                 0 => specials[rng.gen_range(0..specials.len())],
                 // On a cell boundary of the unit box's grid.
                 1..=9 => rng.gen_range(0..=1u32 << MAX_DEPTH) as f32 / (1u32 << MAX_DEPTH) as f32,

@@ -18,18 +18,22 @@ const AFFINE_ROW_TOLERANCE: f32 = 1e-5;
 /// `numpy.asarray(obj)` (a no-op for an array; an aligned copy of a
 /// misaligned one), any failure as a `ValueError` naming the argument.
 fn as_ndarray<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyAny>> {
-    let py = obj.py();
-    if let Ok(a) = obj.cast::<numpy::PyUntypedArray>() {
-        // A misaligned array (a buffer read at an odd offset) cannot be
-        // read as a slice: an aligned copy is (`ndarray.copy`).
-        if !a.is_aligned() {
-            return obj.call_method0("copy");
-        }
-        return Ok(obj.clone());
+    let a = if obj.is_instance_of::<numpy::PyUntypedArray>() {
+        obj.clone()
+    } else {
+        asarray(obj.py())?
+            .call1((obj,))
+            .map_err(|e| PyValueError::new_err(format!("{what}: not an array ({e})")))?
+    };
+    // A misaligned array (a buffer read at an odd offset, as an ndarray or
+    // wrapped by `asarray` without a copy) cannot be read as a slice: an
+    // aligned copy can (`ndarray.copy`).
+    match a.cast::<numpy::PyUntypedArray>() {
+        Ok(u) if !u.is_aligned() => a
+            .call_method0("copy")
+            .map_err(|e| PyValueError::new_err(format!("{what}: cannot copy ({e})"))),
+        _ => Ok(a),
     }
-    asarray(py)?
-        .call1((obj,))
-        .map_err(|e| PyValueError::new_err(format!("{what}: not an array ({e})")))
 }
 
 /// The dtype kind character of an array (`b'f'`, `b'i'`, ...).

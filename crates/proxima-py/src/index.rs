@@ -602,6 +602,11 @@ impl Index {
         let workers = Workers::new(workers)?;
         // Each entry an f32 distance and an i64 id.
         arrays::check_answer_size("nearest", m, k, 12)?;
+        if u32::try_from(m).is_err() {
+            return Err(PyValueError::new_err(format!(
+                "points: at most 2^32 points a batch, got {m}"
+            )));
+        }
         let pts: Vec<_> = v.chunks_exact(3).map(vec3).collect();
         let (inner, ordered, by_slot) = (&self.inner, self.ids.ordered(), self.ids.id_of_slot());
         let table = py

@@ -320,7 +320,7 @@ pub fn nearest(
         // not even 16 rows do (a large k), the rows go straight to their
         // places: no second table as large as the answer. Each query is
         // built as its turn comes and validated by `nearest_into` itself.
-        let fits = STAGED_BYTES / (12 * k);
+        let fits = STAGED_BYTES / 12 / k;
         let block = if fits >= 16 && fits < m { fits } else { m };
         let mut staged = KnnTable {
             distances: vec![0.0; if block < m { block * k } else { 0 }],

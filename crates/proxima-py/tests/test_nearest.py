@@ -395,6 +395,8 @@ def idx(rng):
         # An answer too large to allocate: a Python error, not an abort.
         (lambda i: i.nearest([[0, 0, 0]], 2**62), MemoryError, "does not fit in memory"),
         (lambda i: i.nearest(np.zeros((4, 3)), 2**59), MemoryError, "4 x 576460752303423488"),
+        # No overflow, but more than isize::MAX bytes: the reservation fails.
+        (lambda i: i.nearest(np.zeros((4, 3)), 2**58), MemoryError, "4 x 288230376151711744"),
         (lambda i: i.sweep([[0, 0, 0]], [[1, 1, 1], [2, 2, 2]]), ValueError, "1 starts but 2 ends"),
         (lambda i: i.sweep([[0, 0, 0]], [[1, 1]]), ValueError, "ends"),
         (lambda i: i.sweep([[0, 0, np.nan]], [[1, 1, 1]]), ValueError, "starts: row 0"),
@@ -416,11 +418,11 @@ def test_bad_inputs_raise(idx, call, exc, message):
 
 def test_nearest_batches_over_many_blocks_and_large_k(rng):
     """One worker stages rows a block at a time (4096 rows at k = 10, 204 at
-    k = 200) or, for a small batch or a large k, writes them in place: every
-    way, each row is the oracle's, and two workers agree."""
+    k = 200, 40960 at k = 1) or, for a small batch or a large k, writes them
+    in place: every way, each row is the oracle's, and two workers agree."""
     c, r = scene(rng, n=600)
     idx = proxima.Index(c, r, kind="octree")
-    for m, k in [(9000, 10), (500, 200), (40, 3000), (10, 10), (5000, 1)]:
+    for m, k in [(9000, 10), (500, 200), (40, 3000), (10, 10), (45000, 1)]:
         pts = rng.uniform(-10, 110, (m, 3))
         d, ids = check_knn(idx, c, r, pts, k)
         d2, ids2 = idx.nearest(pts, k, workers=2)
@@ -449,8 +451,16 @@ def test_read_only_and_misaligned_points(idx, rng):
         np.testing.assert_array_equal(got[0], want[0])
         np.testing.assert_array_equal(got[1], want[1])
     few = pts[:5]
+    want = idx.nearest(few, 3)
+    # Not an ndarray: a buffer at an odd offset, which numpy wraps misaligned.
+    raw = b"\0" + few.tobytes()
+    view = memoryview(raw)[1:].cast("d", list(few.shape))
+    assert not np.asarray(view).flags.aligned
+    for got in (idx.nearest(misaligned(few), 3), idx.nearest(view, 3)):
+        np.testing.assert_array_equal(got[0], want[0])
+        np.testing.assert_array_equal(got[1], want[1])
     want = idx.nearest(few.astype(np.float32), 3)
-    for got in (idx.nearest(misaligned(few), 3), idx.nearest(misaligned(few.astype(np.float32)), 3)):
+    for got in (idx.nearest(misaligned(few.astype(np.float32)), 3),):
         np.testing.assert_array_equal(got[0], want[0])
         np.testing.assert_array_equal(got[1], want[1])
 

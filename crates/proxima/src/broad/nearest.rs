@@ -1173,7 +1173,7 @@ mod tests {
                 }
             };
             let p = Vec3::new(u(&mut rng), u(&mut rng), u(&mut rng));
-            let n = rng.gen_range(0..48);
+            let n = rng.gen_range(0..=SEED_MAX);
             let centres: Vec<Vec3> = (0..n)
                 .map(|_| Vec3::new(u(&mut rng), u(&mut rng), u(&mut rng)))
                 .collect();
@@ -1182,8 +1182,20 @@ mod tests {
                 .map(|&c| overlap::point_sphere_distance(p, &Sphere::new(c, 0.0)))
                 .collect();
             exact.sort_unstable_by(f32::total_cmp);
-            let k = [1, 2, 5, 10, 16, 17, LINEAR_MAX_K, LINEAR_MAX_K + 1, 40][round % 9];
-            let limit = if round % 11 == 0 { 0.0 } else { f32::INFINITY };
+            let k = [
+                1,
+                2,
+                3,
+                4,
+                5,
+                10,
+                16,
+                17,
+                LINEAR_MAX_K,
+                LINEAR_MAX_K + 1,
+                40,
+            ][round % 11];
+            let limit = if round % 13 == 0 { 0.0 } else { f32::INFINITY };
             let s2: Vec<f64> = centres
                 .iter()
                 .map(|&c| overlap::point_point_distance_sq(p, c))

@@ -148,6 +148,10 @@ impl ParryCast {
 
 impl Sweeper for ParryCast {
     fn first(&self, s: &SphereSweep) -> Option<(u32, f32)> {
+        self.first_key(s).map(|(i, t)| (i as u32, t))
+    }
+
+    fn first_key(&self, s: &SphereSweep) -> Option<(u64, f32)> {
         let m = Moving::new(s);
         if let ParryCast::Compound(c) = self {
             // The documented one-call composite cast.
@@ -161,7 +165,7 @@ impl Sweeper for ParryCast {
                 options(),
             )
             .ok()??;
-            return Some((hit.subshape1, hit.time_of_impact));
+            return Some((hit.subshape1 as u64, hit.time_of_impact));
         }
         self.with_leaf_cast(|cast| {
             self.tree().find_best(
@@ -170,6 +174,7 @@ impl Sweeper for ParryCast {
                 |i, _| cast(i, &m.pose, m.vel, &m.ball),
             )
         })
+        .map(|(i, t)| (i as u64, t))
     }
 
     fn count(&self, s: &SphereSweep) -> usize {

@@ -9,6 +9,7 @@ use super::LinearOctree;
 use crate::broad::walk::{Cast, Contact};
 use crate::broad::{Filter, RayHit};
 use crate::geom::overlap::EntryBound;
+use crate::prefetch::prefetch;
 
 /// A subtree is skipped only when its box entry `t0` exceeds the best hit by more
 /// than this relative margin: the box and sphere entry parameters are rounded
@@ -145,6 +146,17 @@ impl<T> LinearOctree<T> {
             let k = near ^ j;
             order[m] = (enters[k], k);
             m += (n.children[k] != NONE && enters[k] < f64::INFINITY) as usize;
+        }
+        // Every child to be visited starts loading now, with its octant
+        // masks: the first read of a child node and of a leaf's masks were
+        // the search's two largest stalls (perf: 9% and 4% of its samples
+        // on one load each). W8 first hits 1.083-1.115 -> 1.026-1.056 µs
+        // (two alternations); prefetching all 8 children before the clips
+        // instead: no better.
+        for &(_, k) in &order[..m] {
+            let ch = n.children[k];
+            self.prefetch_node(ch);
+            prefetch(&self.octants[ch as usize]);
         }
         for &(ct0, k) in &order[..m] {
             let ch = n.children[k];

@@ -983,6 +983,8 @@ fn entry_octants_equal_entry_per_box() {
         let halves = [0, 1, 2].map(|a| [(b0.min[a], b0.max[a]), (b1.min[a], b1.max[a])]);
         let got = entry.enter_octants(halves);
         for (i, g) in got.iter().enumerate() {
+            // A zero entry is `+0.0` whatever order the slabs were folded in.
+            assert!(g.is_sign_positive(), "case {k}: box {i} entered at {g}");
             let pick = |a: usize| halves[a][(i >> a) & 1];
             let (x, y, z) = (pick(0), pick(1), pick(2));
             let b = Aabb::new(Vec3::new(x.0, y.0, z.0), Vec3::new(x.1, y.1, z.1));

@@ -37,7 +37,8 @@ impl<T> LinearOctree<T> {
     /// ([`EntryBound::reach_octants`], `LinearOctree::octants`); they take
     /// the cast's four-wide pre-test ([`Contact::misses4`]) where it has one
     /// (sweeps), and those it leaves in go straight to the exact test
-    /// ([`Contact::contact_after_misses4`]). No
+    /// ([`Contact::contact_after_misses4`]). The object of each better hit
+    /// starts loading (`Arena::prefetch`) for the caller's lookup. No
     /// allocation (≤ 8 children listed on the stack per level). Objects
     /// whose filter does not interact with `filter` are skipped at the
     /// candidate.
@@ -85,8 +86,16 @@ impl<T> LinearOctree<T> {
         if n.leaf {
             let offer = |t: Option<f32>, it: &Item, best: &mut Option<RayHit>| {
                 if let Some(t) = t {
-                    if filter.is_none_or(|f| f.interacts(self.obj(it.handle).filter)) {
-                        RayHit::offer(best, t, it.handle);
+                    if filter.is_none_or(|f| f.interacts(self.obj(it.handle).filter))
+                        && RayHit::offer(best, t, it.handle)
+                    {
+                        // The caller will most likely look the answer up:
+                        // its object starts loading while the search goes
+                        // on (W8 first hits with the lookup 1.115-1.128 ->
+                        // 0.970-0.979 µs a sweep, without it 0.880-0.884
+                        // -> 0.923-0.924: two alternations; a prefetch of
+                        // the final answer only, after the search: no gain).
+                        self.objects.prefetch(it.handle);
                     }
                 }
             };

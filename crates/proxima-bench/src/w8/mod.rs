@@ -5,9 +5,13 @@
 //! `4·N^(1/3)`) is loaded into every Proxima index (as W4 builds them) and
 //! into parry3d ([`parry_cast`]). `Q` sweeps: start uniform in the cube,
 //! direction uniform, length uniform in `[5, 20]` (W4's bounded rays),
-//! radius uniform in `[0.5, 2]` (the set's radii). Two kinds: `first`, the
-//! first sphere touched and its time (`SpatialIndex::sweep_first`), and
-//! `hits`, every sphere touched, counted (`for_each_in` a `SphereSweep`).
+//! radius uniform in `[0.5, 2]` (the set's radii). Three kinds: `first`, the
+//! first sphere touched and its time (`SpatialIndex::sweep_first`) as each
+//! library returns it (our `Handle`, parry's leaf index: as W7 times
+//! `nearest_into`); `first+id`, the same mapped to the sphere id (our
+//! `get` of the handle, the lookup a caller makes; parry's leaf index is
+//! the id here); and `hits`, every sphere touched, counted (`for_each_in`
+//! a `SphereSweep`).
 //!
 //! Before timing, the first `C` sweeps of every structure are checked against
 //! LooseKdTree's answers (which the library's oracle tests check against
@@ -152,8 +156,11 @@ pub fn disagreement(
     None
 }
 
-/// The two timed kinds.
-pub const KINDS: [&str; 2] = ["first", "hits"];
+/// The timed kinds: the first hit as each library returns it
+/// ([`Sweeper::first_key`]), the same mapped to the sphere id
+/// ([`Sweeper::first`]: our `get` of the handle; parry's leaf index is the
+/// id), and every hit, counted.
+pub const KINDS: [&str; 3] = ["first", "first+id", "hits"];
 
 /// One structure on one kind.
 #[derive(Clone, Debug)]
@@ -244,14 +251,17 @@ pub fn run(a: &Args) -> (Vec<Row>, Vec<String>) {
         |_, i| built[i].5,
         |k, i| {
             let s = &built[i].3;
-            hits[k][i] = if k == 0 {
+            hits[k][i] = match k {
                 // The native answer, kept (`first_key`).
-                batch
+                0 => batch
                     .iter()
                     .filter(|sw| std::hint::black_box(s.first_key(sw)).is_some())
-                    .count() as u64
-            } else {
-                batch.iter().map(|sw| s.count(sw) as u64).sum()
+                    .count() as u64,
+                1 => batch
+                    .iter()
+                    .filter(|sw| std::hint::black_box(s.first(sw)).is_some())
+                    .count() as u64,
+                _ => batch.iter().map(|sw| s.count(sw) as u64).sum(),
             };
         },
     );
@@ -382,7 +392,15 @@ mod tests {
         let a = query_args::parse(argv.iter().map(|s| s.to_string()), false, 10).expect("valid");
         let (rows, errors) = run(&a);
         assert!(errors.is_empty(), "{errors:?}");
-        assert_eq!(rows.iter().filter(|r| r.batch.is_some()).count(), 2 * 8);
+        assert_eq!(rows.iter().filter(|r| r.batch.is_some()).count(), 3 * 8);
+        // Both first-hit kinds find the same number of hits.
+        for (a, b) in rows
+            .iter()
+            .filter(|r| r.kind == "first")
+            .zip(rows.iter().filter(|r| r.kind == "first+id"))
+        {
+            assert_eq!((a.name, a.mode, a.hits), (b.name, b.mode, b.hits));
+        }
         // Every structure finds the same hits in total, and some.
         let first = rows.iter().find(|r| r.kind == "hits").expect("rows").hits;
         assert!(first > 0);

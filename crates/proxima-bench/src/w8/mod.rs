@@ -165,7 +165,7 @@ pub const KINDS: [&str; 3] = ["first", "first+id", "hits"];
 /// One structure on one kind.
 #[derive(Clone, Debug)]
 pub struct Row {
-    /// `first` or `hits`.
+    /// `first`, `first+id` or `hits` ([`KINDS`]).
     pub kind: &'static str,
     /// Structure.
     pub name: &'static str,
@@ -177,7 +177,8 @@ pub struct Row {
     pub build: Duration,
     /// Median batch time; `None` when not timed (it disagreed).
     pub batch: Option<Duration>,
-    /// Sweeps with a first hit (`first`) or hits in total (`hits`), per batch.
+    /// Sweeps with a first hit (`first`, `first+id`) or hits in total
+    /// (`hits`), per batch.
     pub hits: u64,
 }
 
@@ -229,8 +230,21 @@ pub fn run(a: &Args) -> (Vec<Row>, Vec<String>) {
     let mut errors = Vec::new();
     let answer = |s: &dyn Sweeper, sw: &SphereSweep| (s.first(sw), s.hits(sw));
     let want: Vec<_> = checked.iter().map(|sw| answer(&*built[0].3, sw)).collect();
-    for (name, mode, _, s, _, ok) in built.iter_mut().skip(1) {
+    for (j, (name, mode, _, s, _, ok)) in built.iter_mut().enumerate() {
         for (i, sw) in checked.iter().enumerate() {
+            // The timed call (`first_key`) answers what the checked one
+            // does: the same time, or none for both.
+            let (timed, mapped) = (s.first_key(sw), s.first(sw));
+            if timed.map(|h| h.1) != mapped.map(|h| h.1) {
+                errors.push(format!(
+                    "W8: {name} {mode} first_key {timed:?} against first {mapped:?} on sweep {i}"
+                ));
+                *ok = false;
+                break;
+            }
+            if j == 0 {
+                continue;
+            }
             let got = answer(&**s, sw);
             let reference = (want[i].0, &want[i].1[..]);
             if let Some(why) = disagreement(&w.spheres, sw, reference, (got.0, &got.1)) {

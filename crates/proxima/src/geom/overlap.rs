@@ -1281,11 +1281,13 @@ impl RayClip {
     /// `a` is one of the two intervals `halves[a]`: box `k` takes
     /// `halves[a][(k >> a) & 1]`, as an octree's children take their cells'
     /// halves. Box `k`'s `t0` from `clip`, bit for bit (the same slab
-    /// parameters, folded in the same axis order), or `+∞` where `clip` is
-    /// `None` (or its `t0` is `+∞`), for 12 slab parameters instead of 48
-    /// and no branch per box (an `Option` per box mispredicted ~10 times a
-    /// W8 octree first-hit sweep, callgrind): what an octree's cast search
-    /// needs per inner node.
+    /// parameters; folded y and z first, then x, which gives the same
+    /// largest entry and smallest exit, and [`RayClip::widen_interval`]
+    /// makes a zero entry `+0.0` whatever the order), or `+∞` where `clip`
+    /// is `None` (or its `t0` is `+∞`), for 12 slab parameters instead of
+    /// 48 and no branch per box (an `Option` per box mispredicted ~10
+    /// times a W8 octree first-hit sweep, callgrind): what an octree's cast
+    /// search needs per inner node.
     #[inline(always)]
     pub(crate) fn entry_octants(&self, halves: [[(f32, f32); 2]; 3]) -> [f64; 8] {
         // Written out: as `[0, 1, 2].map(..)` this compiled to an
@@ -1305,7 +1307,7 @@ impl RayClip {
         // same largest entry and smallest exit, NaNs ignored either way,
         // and a zero entry's sign made `+` by `widen_interval`). Against a
         // fold per box with an `Option` per slab (callgrind, W8 octree
-        // first hits as in `LinearOctree::first_tree`'s notes): 9.1k ->
+        // first hits as in `LinearOctree::first_node`'s notes): 9.1k ->
         // 8.3k instructions and 48 -> 34 mispredicted branches a sweep.
         let mut out = [0.0; 8];
         for j in 0..4 {
@@ -1357,9 +1359,9 @@ impl RayClip {
         (t0 <= t1).then_some((t0, t1))
     }
 
-    /// [`RayClip::finish`]'s interval before the emptiness test: apart, so
-    /// that [`RayClip::entry_octants`] can turn an empty one into `+∞`
-    /// without an `Option` per box.
+    /// [`RayClip::finish`]'s interval before the emptiness test: the three
+    /// slabs folded in axis order, then [`RayClip::widen_interval`] (which
+    /// [`RayClip::entry_octants`] shares).
     #[inline(always)]
     fn widened(&self, slabs: [(f64, f64); 3]) -> (f64, f64) {
         let mut near = f64::NEG_INFINITY;

@@ -980,7 +980,28 @@ fn entry_octants_equal_entry_per_box() {
             entry_box(&mut rng, o, d, k),
             entry_box(&mut rng, o, d, k + 1),
         );
-        let halves = [0, 1, 2].map(|a| [(b0.min[a], b0.max[a]), (b1.min[a], b1.max[a])]);
+        let mut halves = [0, 1, 2].map(|a| [(b0.min[a], b0.max[a]), (b1.min[a], b1.max[a])]);
+        // Sides the boxes never have, which the clip must treat alike: a
+        // NaN side (ignored) and `-0.0` for every zero side.
+        let side = |rng: &mut Pcg64| (rng.gen_range(0..3), rng.gen_range(0..2));
+        if k % 11 == 3 {
+            let (a, h) = side(&mut rng);
+            halves[a][h].1 = f32::NAN;
+        }
+        if k % 11 == 7 {
+            let (a, h) = side(&mut rng);
+            halves[a][h].0 = f32::NAN;
+        }
+        if k % 3 == 1 {
+            for (l, h) in halves.iter_mut().flatten() {
+                if *l == 0.0 {
+                    *l = -0.0;
+                }
+                if *h == 0.0 {
+                    *h = -0.0;
+                }
+            }
+        }
         let got = entry.enter_octants(halves);
         for (i, g) in got.iter().enumerate() {
             // A zero entry is `+0.0` whatever order the slabs were folded in.

@@ -156,7 +156,7 @@ impl<T> LinearOctree<T> {
             order[m] = (enters[k], k);
             m += (n.children[k] != NONE && enters[k] < f64::INFINITY) as usize;
         }
-        // Every child to be visited starts loading now, with its octant
+        // Every child entered starts loading now, with its octant
         // masks: the first read of a child node and of a leaf's masks were
         // the search's two largest stalls (perf: 9% and 4% of its samples
         // on one load each). W8 first hits 1.083-1.115 -> 1.026-1.056 µs

@@ -182,8 +182,8 @@ impl<V> Arena<V> {
     /// Starts loading `h`'s slot into the caches, for a [`Arena::get`] of it
     /// that will likely follow (a search's answer, which its caller looks
     /// up): the slot's first line and the next slot's, so that a slot
-    /// straddling two lines comes whole. Only a hint: reads nothing, and a
-    /// stale or foreign handle is harmless. O(1).
+    /// straddling two lines comes whole. Only a hint: it reads no slot, and
+    /// a stale or foreign handle is harmless. O(1).
     #[inline(always)]
     pub fn prefetch(&self, h: Handle) {
         let i = h.index as usize;

@@ -8,6 +8,7 @@ use super::cell_grid::keys::KeyBox;
 use super::walk::Walk;
 use super::Filter;
 use crate::error::check_vec3;
+use crate::geom::overlap::{above as hi, below as lo};
 use crate::geom::{overlap, Aabb, Sphere};
 use crate::{Error, Handle, Result};
 use glam::Vec3;
@@ -267,30 +268,6 @@ pub(crate) struct KBest<'a> {
     /// `bound` but after [`KBest::offer_unsynced`], whose caller syncs them
     /// later ([`KBest::sync`]).
     synced: f32,
-}
-
-/// The smaller of two keys of [`KBest::tighten_by_centres`]. The keys are
-/// never NaN, so these plain comparisons are `min` and `max` and compile to
-/// one instruction each (`f64::min` handles NaN, and the `u64` bits have no
-/// SSE2 min: both cost several: 1.70k -> 1.01k instructions a query,
-/// callgrind on `examples/knn_leaf`, 100k points, k = 10).
-#[inline(always)]
-fn lo(a: f64, b: f64) -> f64 {
-    if a < b {
-        a
-    } else {
-        b
-    }
-}
-
-/// The larger of two keys; see [`lo`].
-#[inline(always)]
-fn hi(a: f64, b: f64) -> f64 {
-    if a > b {
-        a
-    } else {
-        b
-    }
 }
 
 /// Inserts `x` into `top` (ascending; `∞` for "none yet"), dropping the
